@@ -1,0 +1,48 @@
+// emoface: MPEG-4 FAP-driven facial expressions with morphing wrinkles.
+#include <cstdio>
+#include <exception>
+#include <vector>
+
+#include <spdlog/spdlog.h>
+
+#include "command.h"
+#include "emoface/common/error.h"
+
+namespace emoface::apps {
+std::vector<CommandSetup>& registered_commands();
+}
+
+int main(int argc, char** argv) {
+    using namespace emoface::apps;
+    CLI::App app{
+        "emoface: plays MPEG-4 facial animation (FAP files) and emotion mixtures\n"
+        "on a face mesh, with wrinkle maps morphed every frame and bump-mapped."};
+    app.require_subcommand(1);
+    app.set_version_flag("--version", "emoface 0.1.0");
+    bool verbose = false;
+    app.add_flag("-v,--verbose", verbose, "Print debug messages");
+    for (CommandSetup setup : registered_commands()) setup(app);
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForAllHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForVersion& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        app.exit(e);
+        return kExitBadInput;
+    } catch (const emoface::EnvironmentError& e) {
+        std::fprintf(stderr, "emoface: %s\n", e.what());
+        return kExitEnvironment;
+    } catch (const emoface::Error& e) {
+        std::fprintf(stderr, "emoface: %s\n", e.what());
+        return kExitBadInput;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "emoface: internal error: %s\n", e.what());
+        return 1;
+    }
+    return kExitOk;
+}

@@ -1,0 +1,28 @@
+# emoface_add_module(<name> SOURCES ... [PUBLIC_DEPS ...] [PRIVATE_DEPS ...])
+# One library target per module folder (DESIGN.md): emoface_<name>, alias
+# emoface::<name>, public headers under <name>/include/emoface/<name>/.
+function(emoface_add_module name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;PUBLIC_DEPS;PRIVATE_DEPS" ${ARGN})
+  add_library(emoface_${name} STATIC ${ARG_SOURCES})
+  add_library(emoface::${name} ALIAS emoface_${name})
+  target_include_directories(emoface_${name} PUBLIC
+    $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>)
+  target_link_libraries(emoface_${name} PUBLIC emoface::common ${ARG_PUBLIC_DEPS}
+                                        PRIVATE ${ARG_PRIVATE_DEPS})
+  target_compile_options(emoface_${name} PRIVATE
+    $<$<COMPILE_LANGUAGE:CXX>:-Wall -Wextra -Wpedantic>)
+endfunction()
+
+# emoface_add_test(<name> SOURCES ... DEPS ...): a GoogleTest executable whose
+# tests ctest discovers; the test's working directory is the build tree.
+function(emoface_add_test name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS;LABELS" ${ARGN})
+  add_executable(${name} ${ARG_SOURCES})
+  target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main)
+  target_compile_definitions(${name} PRIVATE
+    EMOFACE_DATA_DIR="${EMOFACE_DATA_DIR}"
+    EMOFACE_REALDATA_DIR="${EMOFACE_REALDATA_DIR}"
+    EMOFACE_TEST_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
+  gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60
+    PROPERTIES LABELS "${ARG_LABELS}")
+endfunction()
