@@ -19,8 +19,8 @@ int main(int argc, char** argv) {
         "on a face mesh, with wrinkle maps morphed every frame and bump-mapped."};
     app.require_subcommand(1);
     app.set_version_flag("--version", "emoface 0.1.0");
-    bool verbose = false;
-    app.add_flag("-v,--verbose", verbose, "Print debug messages");
+    app.add_flag_callback(
+        "-v,--verbose", [] { spdlog::set_level(spdlog::level::debug); }, "Print debug messages");
     for (CommandSetup setup : registered_commands()) setup(app);
 
     try {
