@@ -1,7 +1,9 @@
 #include "emoface/expression/feature_layout.h"
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
+#include <sstream>
 
 #include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
@@ -50,6 +52,61 @@ FeatureLayout anchored_layout(const std::array<glm::vec2, kFeatureCount>& uvs,
     for (int i = 0; i < kFeatureCount; ++i)
         if (present[i]) layout.points[i] = {uvs[i].x, 1.0f - uvs[i].y};
     return layout;
+}
+
+std::string layout_to_json(const FeatureLayout& layout) {
+    nlohmann::ordered_json doc;
+    doc["convention"] = "normalised texture coordinates: x to the image's right (the face's left), y down the image";
+    nlohmann::ordered_json points = nlohmann::ordered_json::object();
+    for (int i = 0; i < kFeatureCount; ++i)
+        if (layout.present[i])
+            points[std::string(fap::feature_points()[i].id)] = {layout.points[i].x, layout.points[i].y};
+    doc["points"] = points;
+    return doc.dump(1) + "\n";
+}
+
+FeatureLayout layout_from_json(std::string_view text, const std::string& source) {
+    nlohmann::json doc;
+    try {
+        doc = nlohmann::json::parse(text);
+    } catch (const nlohmann::json::exception& e) {
+        fail<InputError>("expression: {}: not valid JSON ({})", source, e.what());
+    }
+    if (!doc.is_object() || !doc.contains("points") || !doc["points"].is_object())
+        fail<InputError>("expression: {}: expected an object \"points\" mapping feature point ids to [x, y]", source);
+    FeatureLayout layout;
+    for (const auto& [id, value] : doc["points"].items()) {
+        const auto index = fap::find_feature_point(id);
+        if (!index) fail<InputError>("expression: {}: unknown feature point \"{}\"", source, id);
+        if (!value.is_array() || value.size() != 2 || !value[0].is_number() || !value[1].is_number() ||
+            !std::isfinite(value[0].get<double>()) || !std::isfinite(value[1].get<double>()))
+            fail<InputError>("expression: {}: feature point {}: expected [x, y] with finite numbers, found {}",
+                             source, id, value.dump());
+        layout.points[*index] = {value[0].get<float>(), value[1].get<float>()};
+        layout.present[*index] = true;
+    }
+    return layout;
+}
+
+void save_layout(const FeatureLayout& layout, const std::string& path) {
+    const std::string temporary = path + ".tmp";
+    {
+        std::ofstream out(temporary, std::ios::binary);
+        out << layout_to_json(layout);
+        if (!out) fail<InputError>("expression: {}: cannot write the layout", path);
+    }
+    if (std::rename(temporary.c_str(), path.c_str()) != 0) {
+        std::remove(temporary.c_str());
+        fail<InputError>("expression: {}: cannot write the layout", path);
+    }
+}
+
+FeatureLayout load_layout(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) fail<InputError>("expression: {}: cannot open the layout", path);
+    std::stringstream text;
+    text << in.rdbuf();
+    return layout_from_json(text.str(), path);
 }
 
 std::vector<FeatureLine> load_feature_lines(const std::string& path) {

@@ -8,6 +8,7 @@
 #include <array>
 #include <bitset>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/vec2.hpp>
@@ -52,6 +53,14 @@ FeatureLayout projective_layout(const std::array<glm::vec3, kFeatureCount>& posi
 // OpenGL store it; converted here to the image-down convention).
 FeatureLayout anchored_layout(const std::array<glm::vec2, kFeatureCount>& uvs,
                               const std::bitset<kFeatureCount>& present);
+
+// A layout as JSON, so a painted key map can come with its own layout:
+//   {"convention": "...", "points": {"2.1": [x, y], ...}}
+// with x, y normalised, y down the image. Points not listed are absent.
+std::string layout_to_json(const FeatureLayout& layout);
+FeatureLayout layout_from_json(std::string_view text, const std::string& source);
+void save_layout(const FeatureLayout& layout, const std::string& path);  // temp + rename
+FeatureLayout load_layout(const std::string& path);
 
 // A feature line: two feature-point indices.
 struct FeatureLine {
