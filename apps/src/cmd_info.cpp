@@ -1,0 +1,178 @@
+// emoface info FILE... [--json]: what a FAP file holds.
+#include <algorithm>
+#include <cstdio>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "command.h"
+#include "emoface/common/error.h"
+#include "emoface/fap/fap_io.h"
+
+namespace {
+
+using namespace emoface::fap;
+
+struct FapRange {
+    int fap;
+    double min, max;
+    std::size_t frames;  // frames that transmit it
+};
+
+struct Summary {
+    std::vector<FapRange> moving;  // transmitted with some non-zero value
+    std::size_t viseme_frames = 0;
+    std::set<int> viseme_codes;
+    std::size_t expression_frames = 0;
+    std::map<int, int> expression_peak;  // code -> highest intensity seen
+};
+
+Summary summarize(const FapStream& s) {
+    Summary out;
+    for (int fap = 3; fap <= kFapCount; ++fap) {
+        FapRange r{fap, 0, 0, 0};
+        bool nonzero = false;
+        for (const FapFrame& f : s.frames) {
+            if (!f.has(fap)) continue;
+            const double v = f.get(fap);
+            r.min = r.frames == 0 ? v : std::min(r.min, v);
+            r.max = r.frames == 0 ? v : std::max(r.max, v);
+            ++r.frames;
+            nonzero = nonzero || v != 0;
+        }
+        if (nonzero) out.moving.push_back(r);
+    }
+    for (const FapFrame& f : s.frames) {
+        if (f.has(1)) {
+            ++out.viseme_frames;
+            out.viseme_codes.insert(f.viseme.select1);
+            if (f.viseme.blend != 0 || f.viseme.select2 != 0) out.viseme_codes.insert(f.viseme.select2);
+        }
+        if (f.has(2)) {
+            ++out.expression_frames;
+            const Expression& e = f.expression;
+            auto peak = [&](int code, int intensity) {
+                auto [it, inserted] = out.expression_peak.emplace(code, intensity);
+                if (!inserted) it->second = std::max(it->second, intensity);
+            };
+            peak(e.select1, e.intensity1);
+            if (e.select2 != 0 || e.intensity2 != 0) peak(e.select2, e.intensity2);
+        }
+    }
+    return out;
+}
+
+std::string code_label(std::string_view name, int code) {
+    return name.empty() ? fmt::format("code {}", code) : std::string(name);
+}
+
+void print_text(const std::string& path, const FapStream& s) {
+    const Summary sum = summarize(s);
+    fmt::print("{}\n", path);
+    fmt::print("  version   {}\n", s.version);
+    fmt::print("  name      {}\n", s.name.empty() ? "(none)" : s.name);
+    fmt::print("  fps       {}\n", s.fps);
+    if (s.frames.empty())
+        fmt::print("  frames    0\n");
+    else
+        fmt::print("  frames    {} (numbered {}..{})\n", s.frames.size(), s.frames.front().number,
+                   s.frames.back().number);
+    fmt::print("  duration  {:.3f} s\n", s.duration());
+    if (sum.moving.empty()) {
+        fmt::print("  moving    none\n");
+    } else {
+        fmt::print("  moving    {} FAPs\n", sum.moving.size());
+        for (const FapRange& r : sum.moving)
+            fmt::print("    {:>2} {:<22} {} .. {}\n", r.fap, fap_info(r.fap).name, r.min, r.max);
+    }
+    if (sum.viseme_frames == 0) {
+        fmt::print("  FAP 1     not used\n");
+    } else {
+        std::vector<std::string> codes;
+        for (int c : sum.viseme_codes) codes.push_back(fmt::format("{} ({})", c, code_label(viseme_name(c), c)));
+        fmt::print("  FAP 1     {} frames, visemes {}\n", sum.viseme_frames, fmt::join(codes, ", "));
+    }
+    if (sum.expression_frames == 0) {
+        fmt::print("  FAP 2     not used\n");
+    } else {
+        std::vector<std::string> peaks;
+        for (auto [code, intensity] : sum.expression_peak)
+            peaks.push_back(fmt::format("{} up to {}", code_label(expression_name(code), code), intensity));
+        fmt::print("  FAP 2     {} frames, {}\n", sum.expression_frames, fmt::join(peaks, ", "));
+    }
+    if (s.warnings.empty()) {
+        fmt::print("  warnings  none\n");
+    } else {
+        fmt::print("  warnings  {}\n", s.warnings.size());
+        for (const std::string& w : s.warnings) fmt::print("    {}\n", w);
+    }
+}
+
+nlohmann::json to_json(const std::string& path, const FapStream& s) {
+    const Summary sum = summarize(s);
+    nlohmann::json j;
+    j["file"] = path;
+    j["version"] = s.version;
+    j["name"] = s.name;
+    j["fps"] = s.fps;
+    j["frames"] = s.frames.size();
+    j["first_frame_number"] = s.frames.empty() ? nlohmann::json() : nlohmann::json(s.frames.front().number);
+    j["last_frame_number"] = s.frames.empty() ? nlohmann::json() : nlohmann::json(s.frames.back().number);
+    j["duration_s"] = s.duration();
+    j["moving_faps"] = nlohmann::json::array();
+    for (const FapRange& r : sum.moving)
+        j["moving_faps"].push_back({{"fap", r.fap},
+                                    {"name", fap_info(r.fap).name},
+                                    {"min", r.min},
+                                    {"max", r.max},
+                                    {"frames", r.frames}});
+    j["viseme"] = {{"frames", sum.viseme_frames}, {"codes", sum.viseme_codes}};
+    nlohmann::json expressions = nlohmann::json::array();
+    for (auto [code, intensity] : sum.expression_peak)
+        expressions.push_back({{"code", code}, {"name", expression_name(code)}, {"max_intensity", intensity}});
+    j["expression"] = {{"frames", sum.expression_frames}, {"expressions", expressions}};
+    j["warnings"] = s.warnings;
+    return j;
+}
+
+void add_info_command(CLI::App& root) {
+    auto* sub = root.add_subcommand(
+        "info", "Summarise FAP files: version, name, fps, frames, duration, moving FAPs, FAP 1/2 use, warnings");
+    auto files = std::make_shared<std::vector<std::string>>();
+    auto json = std::make_shared<bool>(false);
+    sub->add_option("files", *files, "FAP files")->required();
+    sub->add_flag("--json", *json, "Print a JSON array, one object per file");
+    sub->callback([files, json] {
+        // Every file is reported; a bad one is named on stderr and makes the
+        // exit code 2 once the others are done.
+        std::vector<std::string> failures;
+        nlohmann::json all = nlohmann::json::array();
+        for (const std::string& path : *files) {
+            try {
+                const FapStream s = read_fap_file(path);
+                if (*json)
+                    all.push_back(to_json(path, s));
+                else
+                    print_text(path, s);
+            } catch (const emoface::Error& e) {
+                failures.push_back(e.what());
+                if (*json) all.push_back({{"file", path}, {"error", e.what()}});
+            }
+        }
+        if (*json) fmt::print("{}\n", all.dump(2));
+        std::fflush(stdout);
+        if (failures.empty()) return;
+        // main prints the last one; the others go out the same way here.
+        for (std::size_t i = 0; i + 1 < failures.size(); ++i)
+            std::fprintf(stderr, "emoface: %s\n", failures[i].c_str());
+        throw emoface::InputError(failures.back());
+    });
+}
+
+}  // namespace
+
+EMOFACE_COMMAND(add_info_command)

@@ -1,0 +1,139 @@
+// The ASCII FAP writer: writes exactly what fap_reader.cpp reads back.
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <string>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "emoface/common/error.h"
+#include "emoface/fap/fap_io.h"
+#include "text.h"
+
+namespace emoface::fap {
+
+namespace {
+
+bool is_version(std::string_view v) {
+    std::size_t i = 0;
+    while (i < v.size() && v[i] >= '0' && v[i] <= '9') ++i;
+    if (i == 0) return false;
+    if (i == v.size()) return true;
+    if (v[i] != '.' || i + 1 == v.size()) return false;
+    for (std::size_t j = i + 1; j < v.size(); ++j)
+        if (v[j] < '0' || v[j] > '9') return false;
+    return true;
+}
+
+std::string header_line(const FapStream& s) {
+    if (!is_version(s.version))
+        fail<InputError>("fap: format_fap: expected a version such as 2.1, found {}",
+                         detail::quoted(s.version));
+    if (s.name.find_first_of("\r\n") != std::string::npos || detail::trim(s.name) != s.name)
+        fail<InputError>("fap: format_fap: expected a name without line breaks or leading and "
+                         "trailing spaces, found {}",
+                         detail::quoted(s.name));
+    if (!(std::isfinite(s.fps) && s.fps >= 0.001 && s.fps <= 1e6))
+        fail<InputError>("fap: format_fap: expected a frame rate from 0.001 to 1000000, found {}", s.fps);
+    if (static_cast<long long>(s.frames.size()) > kMaxFapFrames)
+        fail<InputError>("fap: format_fap: expected at most {} frames, found {}", kMaxFapFrames,
+                         s.frames.size());
+    std::string line = s.version;
+    if (!s.name.empty()) line += " " + s.name;
+    line += fmt::format(" {} {}", s.fps, s.frames.size());
+    // A name of 65 or 66 numbers would make the header read as a mask line.
+    detail::Tokens<kFapCount + 1> tokens(line);
+    if (tokens.count == kFapCount || tokens.count == kFapCount + 1) {
+        bool numeric = true;
+        for (std::size_t i = 0; i < tokens.count && numeric; ++i) {
+            double v = 0;
+            numeric = detail::parse_number(tokens.items[i], v) == detail::NumberStatus::Ok;
+        }
+        if (numeric)
+            fail<InputError>("fap: format_fap: expected a name that is not {} numbers (the header "
+                             "would read as a mask line), found {}",
+                             tokens.count - 3, detail::quoted(s.name));
+    }
+    return line;
+}
+
+}  // namespace
+
+std::string format_fap(const FapStream& s) {
+    std::string out = header_line(s);
+    out += '\n';
+    fmt::memory_buffer line;
+    for (std::size_t k = 0; k < s.frames.size(); ++k) {
+        const FapFrame& f = s.frames[k];
+        if (f.number < 0)
+            fail<InputError>("fap: format_fap: frame {}: expected a frame number >= 0, found {}",
+                             k + 1, f.number);
+        for (std::size_t i = 0; i < kFapCount; ++i) {
+            out += f.mask[i] ? '1' : '0';
+            out += i + 1 < kFapCount ? ' ' : '\n';
+        }
+        line.clear();
+        fmt::format_to(std::back_inserter(line), "{}", f.number);
+        if (f.mask[0]) {
+            const Viseme& v = f.viseme;
+            fmt::format_to(std::back_inserter(line), " {} {} {} {}", v.select1, v.select2, v.blend, v.def);
+        }
+        if (f.mask[1]) {
+            const Expression& e = f.expression;
+            fmt::format_to(std::back_inserter(line), " {} {} {} {} {} {}", e.select1, e.intensity1,
+                           e.select2, e.intensity2, e.init_face, e.def);
+        }
+        for (std::size_t i = 2; i < kFapCount; ++i) {
+            if (!f.mask[i]) continue;
+            if (!std::isfinite(f.values[i]))
+                fail<InputError>("fap: format_fap: frame {}: expected a finite value for FAP {} {}, "
+                                 "found {}",
+                                 k + 1, i + 1, fap_table()[i].name, f.values[i]);
+            // The shortest text that reads back as the same double.
+            fmt::format_to(std::back_inserter(line), " {}", f.values[i]);
+        }
+        out.append(line.data(), line.size());
+        out += '\n';
+    }
+    return out;
+}
+
+void write_fap_file(const FapStream& stream, const std::string& path) {
+    const std::string text = format_fap(stream);
+    // A temporary file in the same folder, renamed over path once complete,
+    // so no reader ever sees half a file.
+    std::string temp = path + ".tmp-XXXXXX";
+    const int fd = ::mkstemp(temp.data());
+    if (fd < 0)
+        fail<InputError>("fap: {}: expected a writable folder, found {}", path, std::strerror(errno));
+    std::size_t written = 0;
+    while (written < text.size()) {
+        const ssize_t n = ::write(fd, text.data() + written, text.size() - written);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) {
+            const int err = errno;
+            ::close(fd);
+            ::unlink(temp.c_str());
+            fail<InputError>("fap: {}: expected to write {} bytes, found {}", path, text.size(),
+                             std::strerror(err));
+        }
+        written += static_cast<std::size_t>(n);
+    }
+    // mkstemp creates the file 0600; give it the usual permissions.
+    ::fchmod(fd, 0644);
+    if (::close(fd) != 0 || std::rename(temp.c_str(), path.c_str()) != 0) {
+        const int err = errno;
+        ::unlink(temp.c_str());
+        fail<InputError>("fap: {}: expected to replace the file, found {}", path, std::strerror(err));
+    }
+}
+
+bool same_content(const FapStream& a, const FapStream& b) {
+    return a.version == b.version && a.name == b.name && a.fps == b.fps && a.frames == b.frames;
+}
+
+}  // namespace emoface::fap
