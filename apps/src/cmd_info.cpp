@@ -55,7 +55,9 @@ Summary summarize(const FapStream& s) {
         if (f.has(2)) {
             ++out.expression_frames;
             const Expression& e = f.expression;
+            // Neutral (code 0) is the absence of an expression, not one to list.
             auto peak = [&](int code, int intensity) {
+                if (code == 0) return;
                 auto [it, inserted] = out.expression_peak.emplace(code, intensity);
                 if (!inserted) it->second = std::max(it->second, intensity);
             };
@@ -102,7 +104,8 @@ void print_text(const std::string& path, const FapStream& s) {
         std::vector<std::string> peaks;
         for (auto [code, intensity] : sum.expression_peak)
             peaks.push_back(fmt::format("{} up to {}", code_label(expression_name(code), code), intensity));
-        fmt::print("  FAP 2     {} frames, {}\n", sum.expression_frames, fmt::join(peaks, ", "));
+        fmt::print("  FAP 2     {} frames, {}\n", sum.expression_frames,
+                   peaks.empty() ? std::string("neutral only") : fmt::format("{}", fmt::join(peaks, ", ")));
     }
     if (s.warnings.empty()) {
         fmt::print("  warnings  none\n");
