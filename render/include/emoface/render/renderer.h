@@ -1,0 +1,123 @@
+#pragma once
+// The bump-mapping renderer (thesis 4 and 5.5): GLSL 3.3 core, one draw per
+// mesh. Per pixel: base colour from the mesh's own UVs (sRGB texture, decoded
+// to linear); the normal from the wrinkle map (a second, per-frame UV set)
+// brought to world space through the tangent frame (MikkTSpace: B = w N x T);
+// Blinn-Phong as in thesis 5.5.1 (ambient + diffuse N.L + specular (N.H)^s,
+// the specular term only where N.L > 0); output encoded to sRGB.
+// The renderer draws into whatever framebuffer is bound: a Platform's, after
+// begin_frame().
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <glm/mat4x4.hpp>
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include "emoface/expression/mesh.h"
+#include "emoface/render/image.h"
+#include "emoface/render/tangents.h"
+
+namespace emoface::render {
+
+class Platform;
+class WrinkleTexture;
+
+// Colours are linear RGB.
+struct Light {
+    // w = 0: a directional light, xyz the direction towards the light;
+    // w = 1: a point light at xyz (world space). As in fixed-function GL.
+    glm::vec4 position{0.0f, 0.0f, 1.0f, 0.0f};
+    glm::vec3 ambient{0.12f};
+    glm::vec3 diffuse{0.9f};
+    glm::vec3 specular{0.25f};
+};
+
+struct Camera {
+    glm::mat4 view{1.0f};
+    glm::mat4 projection{1.0f};
+    glm::vec3 position{0.0f, 0.0f, 1.0f};
+
+    // A perspective camera at `eye` looking at `center` (vertical field of
+    // view in degrees).
+    static Camera look_at(const glm::vec3& eye, const glm::vec3& center, const glm::vec3& up,
+                          float fovy_degrees, float aspect, float near_plane, float far_plane);
+    // A camera in front of (+z side of) an axis-aligned box, looking down -z,
+    // the box filling `fill` of the smaller side of the view.
+    static Camera frontal(const glm::vec3& box_min, const glm::vec3& box_max, float aspect,
+                          float fovy_degrees = 20.0f, float fill = 0.9f);
+};
+
+struct Material {
+    // Linear RGB multiplied with the base texture (or used alone without one).
+    glm::vec3 base_color{1.0f};
+    // sRGB-encoded base colour image sampled with the mesh's texcoords2D;
+    // null: base_color alone.
+    std::shared_ptr<const ImageRGBA8> base_texture;
+    // Whether this mesh is bump-mapped with the wrinkle map (skin: yes,
+    // eyeballs: no).
+    bool uses_wrinkle_map = true;
+    glm::vec3 specular_color{1.0f};
+    float shininess = 24.0f;
+};
+
+struct DrawOptions {
+    Camera camera;
+    Light light;
+    glm::mat4 model{1.0f};
+    // false draws every mesh with its geometric normal (the side-by-side
+    // comparison "without wrinkles").
+    bool wrinkles = true;
+    bool clear = true;
+    glm::vec3 background{0.16f, 0.17f, 0.19f};  // sRGB-encoded clear colour
+    // Viewport in pixels of the bound framebuffer; zero size = the whole
+    // framebuffer of the platform given to the renderer.
+    std::array<int, 4> viewport{0, 0, 0, 0};
+};
+
+// How the wrinkle map's texels hold the tangent-space normal.
+enum class NormalEncoding {
+    Unsigned,  // n = 2 * texel - 1 (thesis 4.3; 8-bit maps)
+    Signed,    // n = texel (float maps holding the vector itself)
+};
+
+class Renderer {
+public:
+    using MeshId = int;
+
+    // Compiles the shaders in the platform's context (made current).
+    explicit Renderer(Platform& platform);
+    ~Renderer();
+    Renderer(const Renderer&) = delete;
+    Renderer& operator=(const Renderer&) = delete;
+
+    // Uploads a mesh's topology and base UVs and its current shape (with the
+    // base UVs as wrinkle UVs). Meshes are drawn in the order added.
+    MeshId add_mesh(const expression::TriMesh& mesh, const Material& material);
+
+    // The mesh's new shape (points, vertex normals) and wrinkle UVs (one per
+    // vertex; empty = the base UVs); tangents are recomputed for the wrinkle
+    // UVs. The vertex count must not change.
+    void update_mesh(MeshId id, const expression::TriMesh& mesh,
+                     const std::vector<glm::vec2>& wrinkle_uvs = {});
+    // Same with tangents computed by the caller (one per vertex).
+    void update_mesh(MeshId id, const expression::TriMesh& mesh,
+                     const std::vector<glm::vec2>& wrinkle_uvs,
+                     const std::vector<glm::vec4>& tangents);
+
+    void set_material(MeshId id, const Material& material);
+    std::size_t mesh_count() const;
+
+    // Draws every mesh. `wrinkle_map` null, or options.wrinkles false: flat
+    // normals.
+    void draw(const DrawOptions& options, const WrinkleTexture* wrinkle_map);
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace emoface::render

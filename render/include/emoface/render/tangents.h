@@ -1,0 +1,53 @@
+#pragma once
+// Per-vertex tangent frames for tangent-space normal mapping, following the
+// MikkTSpace conventions: the tangent is accumulated per face corner (weighted
+// by the corner's angle, projected into the vertex normal's plane), then
+// orthogonalised against the normal (Gram-Schmidt); w holds the handedness, so
+// the shader rebuilds the bitangent as w * cross(N, T).
+//
+// The wrinkle map is sampled with UVs that change every frame (the projective
+// layout, DESIGN.md "Texture layouts"), so the frames are recomputed every
+// frame on the deformed mesh: TangentFrames keeps its buffers between calls
+// and does not allocate once the vertex count is stable.
+#include <cstddef>
+#include <vector>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include "emoface/expression/mesh.h"
+
+namespace emoface::render {
+
+class TangentFrames {
+public:
+    // Computes one tangent per vertex of `mesh` for the UV set `uvs` (one UV
+    // per vertex, indexed like the mesh's vertices). Uses the mesh's current
+    // points and vertex normals (the mesh must have vertex normals, updated
+    // for its current shape). Faces whose UV triangle has no area (degenerate
+    // UVs) contribute nothing; a vertex left with no usable direction gets a
+    // tangent perpendicular to its normal, derived from the accumulated
+    // bitangent when there is one, else an arbitrary one, with w = +1.
+    // Throws emoface::Error when uvs.size() != mesh.n_vertices() or the mesh
+    // has no vertex normals.
+    void compute(const expression::TriMesh& mesh, const std::vector<glm::vec2>& uvs);
+
+    // Same with the mesh's own per-vertex texcoords2D as the UV set.
+    void compute(const expression::TriMesh& mesh);
+
+    const std::vector<glm::vec4>& tangents() const { return tangents_; }
+
+    // How many vertices got the fallback tangent in the last compute() (all
+    // their faces had degenerate UVs or a tangent along the normal).
+    std::size_t fallback_count() const { return fallback_count_; }
+
+private:
+    std::vector<glm::vec4> tangents_;
+    std::vector<glm::vec3> tangent_sum_;
+    std::vector<glm::vec3> bitangent_sum_;
+    std::vector<glm::vec2> uv_scratch_;
+    std::size_t fallback_count_ = 0;
+};
+
+}  // namespace emoface::render

@@ -1,0 +1,87 @@
+// CUDA-GL interop (thesis 5.4): the wrinkle texture is registered with CUDA
+// once; each frame it is mapped, written through a surface object, unmapped.
+#include <epoxy/gl.h>  // before cuda_gl_interop.h, which includes GL/gl.h
+
+#include <cuda_gl_interop.h>
+#include <cuda_runtime.h>
+
+#include "emoface/render/wrinkle_texture.h"
+
+#include "emoface/common/error.h"
+
+namespace emoface::render {
+namespace {
+
+void check_cuda(cudaError_t e, const char* what) {
+    if (e != cudaSuccess)
+        fail<EnvironmentError>("render: CUDA-GL interop: {}: {} ({})", what,
+                               cudaGetErrorName(e), cudaGetErrorString(e));
+}
+
+}  // namespace
+
+bool cuda_interop_available() {
+    int count = 0;
+    if (cudaGetDeviceCount(&count) != cudaSuccess) {
+        cudaGetLastError();  // clear the sticky "no device" error
+        return false;
+    }
+    return count > 0;
+}
+
+void WrinkleTexture::register_cuda() {
+    if (cuda_resource_) return;
+    if (!cuda_interop_available())
+        fail<EnvironmentError>("render: CUDA-GL interop: no CUDA device");
+    cudaGraphicsResource_t resource = nullptr;
+    check_cuda(cudaGraphicsGLRegisterImage(&resource, texture_, GL_TEXTURE_2D,
+                                           cudaGraphicsRegisterFlagsSurfaceLoadStore),
+               "cudaGraphicsGLRegisterImage (is the GL context on the CUDA device?)");
+    cuda_resource_ = resource;
+}
+
+unsigned long long WrinkleTexture::map_surface(void* stream) {
+    if (surface_) fail("render: WrinkleTexture::map_surface(): already mapped");
+    register_cuda();
+    auto* resource = static_cast<cudaGraphicsResource_t>(cuda_resource_);
+    auto s = static_cast<cudaStream_t>(stream);
+    check_cuda(cudaGraphicsMapResources(1, &resource, s), "cudaGraphicsMapResources");
+    cudaArray_t array = nullptr;
+    // The array may differ from one mapping to the next (CUDA's documentation),
+    // so the surface object is made per mapping; it costs a few microseconds.
+    cudaError_t e = cudaGraphicsSubResourceGetMappedArray(&array, resource, 0, 0);
+    cudaSurfaceObject_t surface = 0;
+    if (e == cudaSuccess) {
+        cudaResourceDesc desc{};
+        desc.resType = cudaResourceTypeArray;
+        desc.res.array.array = array;
+        e = cudaCreateSurfaceObject(&surface, &desc);
+    }
+    if (e != cudaSuccess) {
+        cudaGraphicsUnmapResources(1, &resource, s);
+        check_cuda(e, "getting a surface for the mapped texture");
+    }
+    surface_ = surface;
+    return surface_;
+}
+
+void WrinkleTexture::unmap(void* stream) {
+    if (!surface_) return;
+    auto* resource = static_cast<cudaGraphicsResource_t>(cuda_resource_);
+    cudaDestroySurfaceObject(static_cast<cudaSurfaceObject_t>(surface_));
+    surface_ = 0;
+    check_cuda(cudaGraphicsUnmapResources(1, &resource, static_cast<cudaStream_t>(stream)),
+               "cudaGraphicsUnmapResources");
+}
+
+void WrinkleTexture::unregister_cuda() noexcept {
+    if (!cuda_resource_) return;
+    try {
+        unmap(nullptr);
+    } catch (...) {
+    }
+    cudaGraphicsUnregisterResource(static_cast<cudaGraphicsResource_t>(cuda_resource_));
+    cuda_resource_ = nullptr;
+}
+
+}  // namespace emoface::render

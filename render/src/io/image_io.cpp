@@ -1,0 +1,109 @@
+#include "emoface/render/image_io.h"
+
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <vector>
+
+#include "atomic_file.h"
+#include "emoface/common/error.h"
+
+namespace emoface::render {
+namespace {
+
+template <typename Image>
+void check_image(const std::string& path, const Image& image) {
+    if (image.width <= 0 || image.height <= 0 ||
+        image.pixels.size() != std::size_t(image.width) * image.height * 4)
+        fail("render: {}: cannot write a {}x{} image holding {} values (expected width*height*4)",
+             path, image.width, image.height, image.pixels.size());
+}
+
+void write_pixels(const std::string& path, int width, int height, OIIO::TypeDesc in_type,
+                  OIIO::TypeDesc file_type, const void* pixels) {
+    const std::string temp = detail::temporary_path_for(path);
+    auto out = OIIO::ImageOutput::create(path);  // format from the real name
+    if (!out)
+        fail<InputError>("render: {}: no image format for this extension ({})", path,
+                         OIIO::geterror());
+    OIIO::ImageSpec spec(width, height, 4, file_type);
+    // Our pixels are straight (unassociated) alpha, written as they are.
+    spec.attribute("oiio:UnassociatedAlpha", 1);
+    if (!out->open(temp, spec)) {
+        const std::string why = out->geterror();
+        detail::discard_temporary(temp);
+        fail("render: {}: cannot open for writing: {}", path, why);
+    }
+    const bool wrote = out->write_image(in_type, pixels);
+    const bool closed = out->close();
+    if (!wrote || !closed) {
+        const std::string why = out->geterror();
+        out.reset();
+        detail::discard_temporary(temp);
+        fail("render: {}: writing failed: {}", path, why);
+    }
+    out.reset();
+    detail::commit_temporary(temp, path);
+}
+
+template <typename T>
+std::vector<T> read_rgba(const std::string& path, OIIO::TypeDesc type, int& width, int& height) {
+    // Keep straight alpha as stored (OpenImageIO would premultiply it).
+    OIIO::ImageSpec config;
+    config.attribute("oiio:UnassociatedAlpha", 1);
+    auto in = OIIO::ImageInput::open(path, &config);
+    if (!in) fail<InputError>("render: {}: cannot read the image: {}", path, OIIO::geterror());
+    const OIIO::ImageSpec& spec = in->spec();
+    width = spec.width;
+    height = spec.height;
+    const int channels = spec.nchannels;
+    if (width <= 0 || height <= 0 || channels <= 0 || std::int64_t(width) * height > (1 << 28))
+        fail<InputError>("render: {}: unsupported image size {}x{} with {} channels", path,
+                         width, height, channels);
+    std::vector<T> raw(std::size_t(width) * height * channels);
+    if (!in->read_image(0, 0, 0, channels, type, raw.data()))
+        fail<InputError>("render: {}: cannot read the pixels: {}", path, in->geterror());
+    in->close();
+    const T one = type == OIIO::TypeDesc::UINT8 ? T(255) : T(1);
+    std::vector<T> rgba(std::size_t(width) * height * 4);
+    for (std::size_t i = 0, n = std::size_t(width) * height; i < n; ++i) {
+        const T* s = raw.data() + i * channels;
+        T* d = rgba.data() + i * 4;
+        if (channels >= 3) {
+            d[0] = s[0]; d[1] = s[1]; d[2] = s[2];
+            d[3] = channels >= 4 ? s[3] : one;
+        } else {  // grey, grey + alpha
+            d[0] = d[1] = d[2] = s[0];
+            d[3] = channels == 2 ? s[1] : one;
+        }
+    }
+    return rgba;
+}
+
+}  // namespace
+
+void write_image(const std::string& path, const ImageRGBA8& image) {
+    check_image(path, image);
+    write_pixels(path, image.width, image.height, OIIO::TypeDesc::UINT8, OIIO::TypeDesc::UINT8,
+                 image.pixels.data());
+}
+
+void write_image(const std::string& path, const ImageRGBA32F& image) {
+    check_image(path, image);
+    write_pixels(path, image.width, image.height, OIIO::TypeDesc::FLOAT, OIIO::TypeDesc::HALF,
+                 image.pixels.data());
+}
+
+ImageRGBA8 read_image_rgba8(const std::string& path) {
+    ImageRGBA8 image;
+    image.pixels = read_rgba<std::uint8_t>(path, OIIO::TypeDesc::UINT8, image.width, image.height);
+    return image;
+}
+
+ImageRGBA32F read_image_rgba32f(const std::string& path) {
+    ImageRGBA32F image;
+    image.pixels = read_rgba<float>(path, OIIO::TypeDesc::FLOAT, image.width, image.height);
+    return image;
+}
+
+}  // namespace emoface::render

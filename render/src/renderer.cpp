@@ -1,0 +1,384 @@
+#include "emoface/render/renderer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <glm/gtc/matrix_inverse.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/type_ptr.hpp>
+
+#include "emoface/render/platform.h"
+#include "emoface/render/wrinkle_texture.h"
+#include "gl_util.h"
+#include "shaders.h"
+
+namespace emoface::render {
+
+using detail::check_gl;
+
+Camera Camera::look_at(const glm::vec3& eye, const glm::vec3& center, const glm::vec3& up,
+                       float fovy_degrees, float aspect, float near_plane, float far_plane) {
+    Camera c;
+    c.view = glm::lookAt(eye, center, up);
+    c.projection = glm::perspective(glm::radians(fovy_degrees), aspect, near_plane, far_plane);
+    c.position = eye;
+    return c;
+}
+
+Camera Camera::frontal(const glm::vec3& box_min, const glm::vec3& box_max, float aspect,
+                       float fovy_degrees, float fill) {
+    const glm::vec3 center = 0.5f * (box_min + box_max);
+    const glm::vec3 extent = box_max - box_min;
+    const float half_fov = glm::radians(fovy_degrees) * 0.5f;
+    // Distance at which the box's height (or width, whichever is tighter for
+    // this aspect) spans `fill` of the view.
+    const float half_h = 0.5f * std::max(extent.y, extent.x / std::max(aspect, 1e-6f)) / fill;
+    const float distance = half_h / std::tan(half_fov) + 0.5f * extent.z;
+    const glm::vec3 eye = center + glm::vec3(0.0f, 0.0f, distance);
+    const float depth = std::max(extent.z, 1e-3f);
+    return look_at(eye, center, {0.0f, 1.0f, 0.0f}, fovy_degrees, aspect,
+                   std::max(distance - depth * 2.0f, distance * 0.05f), distance + depth * 2.0f);
+}
+
+namespace {
+
+// Per-vertex data that changes every frame, interleaved.
+struct DynamicVertex {
+    float position[3];
+    float normal[3];
+    float tangent[4];
+    float wrinkle_uv[2];
+};
+static_assert(sizeof(DynamicVertex) == 12 * sizeof(float), "tightly packed");
+
+GLuint compile(GLenum stage, const char* source) {
+    GLuint s = glCreateShader(stage);
+    glShaderSource(s, 1, &source, nullptr);
+    glCompileShader(s);
+    GLint ok = 0;
+    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+        char log[4096] = {};
+        glGetShaderInfoLog(s, sizeof log, nullptr, log);
+        glDeleteShader(s);
+        fail("render: the {} shader does not compile: {}",
+             stage == GL_VERTEX_SHADER ? "vertex" : "fragment", log);
+    }
+    return s;
+}
+
+GLuint link_program(const char* vs_source, const char* fs_source) {
+    const GLuint vs = compile(GL_VERTEX_SHADER, vs_source);
+    GLuint fs = 0;
+    try {
+        fs = compile(GL_FRAGMENT_SHADER, fs_source);
+    } catch (...) {
+        glDeleteShader(vs);
+        throw;
+    }
+    const GLuint p = glCreateProgram();
+    glAttachShader(p, vs);
+    glAttachShader(p, fs);
+    glLinkProgram(p);
+    glDeleteShader(vs);
+    glDeleteShader(fs);
+    GLint ok = 0;
+    glGetProgramiv(p, GL_LINK_STATUS, &ok);
+    if (!ok) {
+        char log[4096] = {};
+        glGetProgramInfoLog(p, sizeof log, nullptr, log);
+        glDeleteProgram(p);
+        fail("render: the bump-mapping program does not link: {}", log);
+    }
+    return p;
+}
+
+GLuint upload_srgb_texture(const ImageRGBA8& image) {
+    if (image.width <= 0 || image.height <= 0 ||
+        image.pixels.size() != std::size_t(image.width) * image.height * 4)
+        fail("render: base texture: {}x{} image with {} bytes, expected width*height*4",
+             image.width, image.height, image.pixels.size());
+    GLuint t = 0;
+    glGenTextures(1, &t);
+    glBindTexture(GL_TEXTURE_2D, t);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_SRGB8_ALPHA8, image.width, image.height, 0, GL_RGBA,
+                 GL_UNSIGNED_BYTE, image.pixels.data());
+    glGenerateMipmap(GL_TEXTURE_2D);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    check_gl("uploading a base texture");
+    return t;
+}
+
+}  // namespace
+
+struct Renderer::Impl {
+    struct Mesh {
+        Material material;
+        GLuint base_texture = 0;
+        GLuint vao = 0, dynamic_vbo = 0, static_vbo = 0, ebo = 0;
+        GLsizei index_count = 0;
+        std::size_t vertex_count = 0;
+        std::vector<glm::vec2> base_uvs;
+        TangentFrames frames;
+        std::vector<DynamicVertex> staging;
+    };
+
+    Platform& platform;
+    GLuint program = 0;
+    struct {
+        GLint model, normal_matrix, view_projection, base_map, has_base_map, base_color,
+            wrinkle_map, use_wrinkle_map, wrinkle_signed, light_position, light_ambient,
+            light_diffuse, light_specular, specular_color, shininess, camera_position;
+    } loc{};
+    std::vector<Mesh> meshes;
+
+    explicit Impl(Platform& p) : platform(p) {}
+
+    Mesh& mesh(MeshId id) {
+        if (id < 0 || std::size_t(id) >= meshes.size())
+            fail("render: Renderer: no mesh {} (there are {})", id, meshes.size());
+        return meshes[std::size_t(id)];
+    }
+
+    void release(Mesh& m) {
+        if (m.base_texture) glDeleteTextures(1, &m.base_texture);
+        const GLuint buffers[3] = {m.dynamic_vbo, m.static_vbo, m.ebo};
+        glDeleteBuffers(3, buffers);
+        if (m.vao) glDeleteVertexArrays(1, &m.vao);
+        m.base_texture = m.vao = m.dynamic_vbo = m.static_vbo = m.ebo = 0;
+    }
+};
+
+Renderer::Renderer(Platform& platform) : impl_(std::make_unique<Impl>(platform)) {
+    platform.make_current();
+    impl_->program = link_program(detail::kBumpVertexShader, detail::kBumpFragmentShader);
+    const GLuint p = impl_->program;
+    auto u = [p](const char* name) { return glGetUniformLocation(p, name); };
+    auto& l = impl_->loc;
+    l.model = u("u_model");
+    l.normal_matrix = u("u_normal_matrix");
+    l.view_projection = u("u_view_projection");
+    l.base_map = u("u_base_map");
+    l.has_base_map = u("u_has_base_map");
+    l.base_color = u("u_base_color");
+    l.wrinkle_map = u("u_wrinkle_map");
+    l.use_wrinkle_map = u("u_use_wrinkle_map");
+    l.wrinkle_signed = u("u_wrinkle_signed");
+    l.light_position = u("u_light_position");
+    l.light_ambient = u("u_light_ambient");
+    l.light_diffuse = u("u_light_diffuse");
+    l.light_specular = u("u_light_specular");
+    l.specular_color = u("u_specular_color");
+    l.shininess = u("u_shininess");
+    l.camera_position = u("u_camera_position");
+    check_gl("Renderer: creating the program");
+}
+
+Renderer::~Renderer() {
+    if (!impl_) return;
+    impl_->platform.make_current();
+    for (auto& m : impl_->meshes) impl_->release(m);
+    if (impl_->program) glDeleteProgram(impl_->program);
+}
+
+std::size_t Renderer::mesh_count() const { return impl_->meshes.size(); }
+
+Renderer::MeshId Renderer::add_mesh(const expression::TriMesh& mesh, const Material& material) {
+    impl_->platform.make_current();
+    if (mesh.n_vertices() == 0 || mesh.n_faces() == 0)
+        fail("render: Renderer::add_mesh(): the mesh is empty ({} vertices, {} faces)",
+             mesh.n_vertices(), mesh.n_faces());
+    if (!mesh.has_vertex_normals())
+        fail("render: Renderer::add_mesh(): the mesh has no vertex normals");
+
+    Impl::Mesh m;
+    m.vertex_count = mesh.n_vertices();
+    std::vector<std::uint32_t> indices;
+    indices.reserve(mesh.n_faces() * 3);
+    for (const auto fh : mesh.faces()) {
+        std::uint32_t tri[3];
+        int k = 0;
+        for (const auto vh : mesh.fv_range(fh)) {
+            if (k < 3) tri[k] = std::uint32_t(vh.idx());
+            ++k;
+        }
+        if (k != 3)
+            fail("render: Renderer::add_mesh(): face {} has {} vertices, expected a triangle",
+                 fh.idx(), k);
+        indices.insert(indices.end(), tri, tri + 3);
+    }
+    m.index_count = GLsizei(indices.size());
+    m.base_uvs.assign(m.vertex_count, glm::vec2(0.0f));
+    if (mesh.has_vertex_texcoords2D())
+        for (const auto vh : mesh.vertices()) {
+            const auto& t = mesh.texcoord2D(vh);
+            m.base_uvs[std::size_t(vh.idx())] = {t[0], t[1]};
+        }
+
+    glGenVertexArrays(1, &m.vao);
+    glGenBuffers(1, &m.dynamic_vbo);
+    glGenBuffers(1, &m.static_vbo);
+    glGenBuffers(1, &m.ebo);
+    glBindVertexArray(m.vao);
+    glBindBuffer(GL_ARRAY_BUFFER, m.dynamic_vbo);
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(m.vertex_count * sizeof(DynamicVertex)), nullptr,
+                 GL_DYNAMIC_DRAW);
+    const auto stride = GLsizei(sizeof(DynamicVertex));
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, stride,
+                          reinterpret_cast<void*>(offsetof(DynamicVertex, position)));
+    glEnableVertexAttribArray(1);
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, stride,
+                          reinterpret_cast<void*>(offsetof(DynamicVertex, normal)));
+    glEnableVertexAttribArray(2);
+    glVertexAttribPointer(2, 4, GL_FLOAT, GL_FALSE, stride,
+                          reinterpret_cast<void*>(offsetof(DynamicVertex, tangent)));
+    glEnableVertexAttribArray(3);
+    glVertexAttribPointer(3, 2, GL_FLOAT, GL_FALSE, stride,
+                          reinterpret_cast<void*>(offsetof(DynamicVertex, wrinkle_uv)));
+    glBindBuffer(GL_ARRAY_BUFFER, m.static_vbo);
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(m.vertex_count * sizeof(glm::vec2)),
+                 m.base_uvs.data(), GL_STATIC_DRAW);
+    glEnableVertexAttribArray(4);
+    glVertexAttribPointer(4, 2, GL_FLOAT, GL_FALSE, sizeof(glm::vec2), nullptr);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, m.ebo);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(indices.size() * sizeof(std::uint32_t)),
+                 indices.data(), GL_STATIC_DRAW);
+    glBindVertexArray(0);
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
+    try {
+        check_gl("Renderer::add_mesh(): uploading the mesh");
+    } catch (...) {
+        impl_->release(m);
+        throw;
+    }
+    impl_->meshes.push_back(std::move(m));
+    const MeshId id = MeshId(impl_->meshes.size() - 1);
+    set_material(id, material);
+    update_mesh(id, mesh);
+    return id;
+}
+
+void Renderer::set_material(MeshId id, const Material& material) {
+    impl_->platform.make_current();
+    Impl::Mesh& m = impl_->mesh(id);
+    GLuint texture = 0;
+    if (material.base_texture) texture = upload_srgb_texture(*material.base_texture);
+    if (m.base_texture) glDeleteTextures(1, &m.base_texture);
+    m.base_texture = texture;
+    m.material = material;
+}
+
+void Renderer::update_mesh(MeshId id, const expression::TriMesh& mesh,
+                           const std::vector<glm::vec2>& wrinkle_uvs) {
+    Impl::Mesh& m = impl_->mesh(id);
+    const std::vector<glm::vec2>& uvs = wrinkle_uvs.empty() ? m.base_uvs : wrinkle_uvs;
+    if (uvs.size() != mesh.n_vertices())
+        fail("render: Renderer::update_mesh(): {} wrinkle UVs for {} vertices", uvs.size(),
+             mesh.n_vertices());
+    m.frames.compute(mesh, uvs);
+    update_mesh(id, mesh, uvs, m.frames.tangents());
+}
+
+void Renderer::update_mesh(MeshId id, const expression::TriMesh& mesh,
+                           const std::vector<glm::vec2>& wrinkle_uvs,
+                           const std::vector<glm::vec4>& tangents) {
+    impl_->platform.make_current();
+    Impl::Mesh& m = impl_->mesh(id);
+    const std::size_t n = mesh.n_vertices();
+    if (n != m.vertex_count)
+        fail("render: Renderer::update_mesh(): mesh {} had {} vertices, now {}", id,
+             m.vertex_count, n);
+    const std::vector<glm::vec2>& uvs = wrinkle_uvs.empty() ? m.base_uvs : wrinkle_uvs;
+    if (uvs.size() != n || tangents.size() != n)
+        fail("render: Renderer::update_mesh(): {} wrinkle UVs and {} tangents for {} vertices",
+             uvs.size(), tangents.size(), n);
+    if (!mesh.has_vertex_normals())
+        fail("render: Renderer::update_mesh(): the mesh has no vertex normals");
+    m.staging.resize(n);
+    for (const auto vh : mesh.vertices()) {
+        const std::size_t i = std::size_t(vh.idx());
+        const auto& p = mesh.point(vh);
+        const auto& nn = mesh.normal(vh);
+        DynamicVertex& d = m.staging[i];
+        d.position[0] = p[0]; d.position[1] = p[1]; d.position[2] = p[2];
+        d.normal[0] = nn[0]; d.normal[1] = nn[1]; d.normal[2] = nn[2];
+        d.tangent[0] = tangents[i].x; d.tangent[1] = tangents[i].y;
+        d.tangent[2] = tangents[i].z; d.tangent[3] = tangents[i].w;
+        d.wrinkle_uv[0] = uvs[i].x; d.wrinkle_uv[1] = uvs[i].y;
+    }
+    glBindBuffer(GL_ARRAY_BUFFER, m.dynamic_vbo);
+    glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(n * sizeof(DynamicVertex)), m.staging.data());
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
+    check_gl("Renderer::update_mesh()");
+}
+
+void Renderer::draw(const DrawOptions& o, const WrinkleTexture* wrinkle_map) {
+    Impl& im = *impl_;
+    im.platform.make_current();
+    if (wrinkle_map && wrinkle_map->mapped())
+        fail("render: Renderer::draw(): the wrinkle map is still mapped for CUDA");
+    std::array<int, 4> vp = o.viewport;
+    if (vp[2] <= 0 || vp[3] <= 0) vp = {0, 0, im.platform.width(), im.platform.height()};
+    glViewport(vp[0], vp[1], vp[2], vp[3]);
+    if (o.clear) {
+        glEnable(GL_SCISSOR_TEST);
+        glScissor(vp[0], vp[1], vp[2], vp[3]);
+        glClearColor(o.background.r, o.background.g, o.background.b, 1.0f);
+        glClearDepth(1.0);
+        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+        glDisable(GL_SCISSOR_TEST);
+    }
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_CULL_FACE);  // eyelids and lips are seen from both sides
+    glDisable(GL_BLEND);
+    glEnable(GL_MULTISAMPLE);
+
+    glUseProgram(im.program);
+    const glm::mat4 view_projection = o.camera.projection * o.camera.view;
+    const glm::mat3 normal_matrix = glm::inverseTranspose(glm::mat3(o.model));
+    glUniformMatrix4fv(im.loc.model, 1, GL_FALSE, glm::value_ptr(o.model));
+    glUniformMatrix3fv(im.loc.normal_matrix, 1, GL_FALSE, glm::value_ptr(normal_matrix));
+    glUniformMatrix4fv(im.loc.view_projection, 1, GL_FALSE, glm::value_ptr(view_projection));
+    glUniform4fv(im.loc.light_position, 1, glm::value_ptr(o.light.position));
+    glUniform3fv(im.loc.light_ambient, 1, glm::value_ptr(o.light.ambient));
+    glUniform3fv(im.loc.light_diffuse, 1, glm::value_ptr(o.light.diffuse));
+    glUniform3fv(im.loc.light_specular, 1, glm::value_ptr(o.light.specular));
+    glUniform3fv(im.loc.camera_position, 1, glm::value_ptr(o.camera.position));
+    glUniform1i(im.loc.base_map, 0);
+    glUniform1i(im.loc.wrinkle_map, 1);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, wrinkle_map ? wrinkle_map->gl_texture() : 0);
+    glUniform1i(im.loc.wrinkle_signed,
+                wrinkle_map && wrinkle_map->encoding() == NormalEncoding::Signed);
+
+    for (const auto& m : im.meshes) {
+        const bool bump = o.wrinkles && wrinkle_map && m.material.uses_wrinkle_map;
+        glUniform1i(im.loc.use_wrinkle_map, bump ? 1 : 0);
+        glUniform1i(im.loc.has_base_map, m.base_texture ? 1 : 0);
+        glUniform3fv(im.loc.base_color, 1, glm::value_ptr(m.material.base_color));
+        glUniform3fv(im.loc.specular_color, 1, glm::value_ptr(m.material.specular_color));
+        glUniform1f(im.loc.shininess, m.material.shininess);
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_2D, m.base_texture);
+        glBindVertexArray(m.vao);
+        glDrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
+    }
+    glBindVertexArray(0);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glUseProgram(0);
+    check_gl("Renderer::draw()");
+}
+
+}  // namespace emoface::render
