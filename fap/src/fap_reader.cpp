@@ -97,7 +97,8 @@ public:
                      : fmt::format("the last {} frames transmit no FAP: dropped", trailing_empty));
         }
         if (suppressed_warnings_ > 0)
-            stream_.warnings.push_back(fmt::format("... and {} more", plural(static_cast<long long>(suppressed_warnings_), "warning", "warnings")));
+            stream_.warnings.push_back(fmt::format("... and {} more {}", suppressed_warnings_,
+                                                   suppressed_warnings_ == 1 ? "warning" : "warnings"));
         return std::move(stream_);
     }
 

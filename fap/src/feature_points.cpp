@@ -6,6 +6,7 @@
 #include <charconv>
 
 #include "emoface/common/error.h"
+#include "text.h"
 
 namespace emoface::fap {
 
@@ -131,8 +132,8 @@ std::optional<int> find_feature_point(std::string_view id) {
 int feature_point_index(std::string_view id) {
     if (auto index = find_feature_point(id)) return *index;
     fail<InputError>("fap: feature_point_index: expected a feature point id such as 3.5 "
-                     "(group 2..11 '.' index), found '{}'",
-                     id.substr(0, 32));
+                     "(group 2..11 '.' index), found {}",
+                     detail::quoted(id));
 }
 
 }  // namespace emoface::fap
