@@ -1,0 +1,285 @@
+#pragma once
+// The Beier-Neely warp-and-blend kernel body, written once for both backends
+// (DESIGN.md "CPU and GPU"): the CPU backend calls these functions from its
+// thread pool over runs of 64 pixels, the CUDA backend from one thread per
+// 1 or 4 pixels. Nothing here allocates, throws or touches a backend API.
+//
+// Geometry (DESIGN.md "Beier-Neely warp", thesis 3.2.2 c). Positions are in
+// "iso" units: pixel coordinates divided by S = max(W, H), so distances mean the
+// same along x and y and MorphParams::a is a fraction of the longer side.
+// For a target line (P, Q) with d = Q - P, len = |d|, unit e = d/len,
+// unit normal n = perp(d)/len (perp(x, y) = (-y, x), the thesis's convention)
+// and midpoint M, a point X has
+//   s = (X - M)·e        (along the line, from its midpoint; u = s/len + 1/2)
+//   v = (X - P)·n        (signed distance across it)
+//   dist = |v| beside the segment, distance to the nearer end beyond it
+//        = sqrt(v² + max(|s| - len/2, 0)²)
+//   w = (len^p / (a + dist))^b = ((a + dist)·len^-p)^-b
+// and in source k, X'_k = P'_k + u d'_k + v n'_k, i.e. a displacement
+//   D_k = X'_k - X = (M'_k - M) + s (d'_k - d)/len + v (n'_k - n)
+// which is affine in (s, v): the host precomputes A = M' - M, B = (d' - d)/len,
+// C = n' - n per line and source, so the kernel does u, v, dist and w once per
+// pixel-line and then 6 multiply-adds per source. Writing D relative to X keeps
+// float precision where the displacement is small (identity maps give D = 0
+// exactly). The pixel's source position is X + Σ w_i D_i / Σ w_i.
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+
+#include "emoface/common/hd.h"
+
+// EMOFACE_UNROLL: loops over sources (at most kMaxKeys) and other short
+// compile-time loops, unrolled on both sides. EMOFACE_PIXEL_LOOP: the loop over
+// a run of points, unrolled into registers on the GPU (1 or 4 points) and
+// vectorised on the CPU (64 points; the accumulators are a local that nothing
+// else can alias).
+#if defined(__CUDACC__)
+#define EMOFACE_UNROLL _Pragma("unroll")
+#define EMOFACE_PIXEL_LOOP _Pragma("unroll")
+#elif defined(__GNUC__) && !defined(__clang__)
+#define EMOFACE_UNROLL _Pragma("GCC unroll 8")
+#define EMOFACE_PIXEL_LOOP _Pragma("GCC ivdep")
+#else
+#define EMOFACE_UNROLL
+#define EMOFACE_PIXEL_LOOP
+#endif
+
+namespace emoface::morph::kernel {
+
+inline constexpr int kMaxKeys = 8;
+
+// One line record (floats): the target line's geometry, then 6 floats for each
+// source taking part in the frame; padded to whole float4s so the GPU loads a
+// record with 16-byte loads.
+enum LineField : int {
+    kEx, kEy, kCs,     // s = X·e + cs
+    kHalfLen,          // len / 2
+    kNx, kNy, kCv,     // v = X·n + cv
+    kWk, kWa,          // a + dist scaled by len^-p: q = dist·wk + wa, w = q^-b
+    kGeomFloats
+};
+inline constexpr int kSourceFloats = 6;  // Ax Ay Bx By Cx Cy
+EMOFACE_HD constexpr int record_floats(int sources) {
+    return (kGeomFloats + kSourceFloats * sources + 3) / 4 * 4;
+}
+
+// b = 2 (the default) needs one reciprocal; any other b goes through exp2/log2.
+enum class Law : int { InverseSquare, Power };
+
+struct Rgba {
+    float r, g, b, a;
+};
+
+// ---- fast math shared by both sides ---------------------------------------
+
+EMOFACE_HD EMOFACE_INLINE float fast_sqrt(float x) {
+#if defined(__CUDA_ARCH__)
+    float r;
+    asm("sqrt.approx.ftz.f32 %0, %1;" : "=f"(r) : "f"(x));
+    return r;
+#else
+    return std::sqrt(x);
+#endif
+}
+
+EMOFACE_HD EMOFACE_INLINE float fast_rcp(float x) {
+#if defined(__CUDA_ARCH__)
+    float r;
+    asm("rcp.approx.ftz.f32 %0, %1;" : "=f"(r) : "f"(x));
+    return r;
+#else
+    return 1.0f / x;
+#endif
+}
+
+EMOFACE_HD EMOFACE_INLINE float pow_neg(float q, float b) {
+#if defined(__CUDA_ARCH__)
+    return exp2f(-b * __log2f(q));
+#else
+    return std::exp2(-b * std::log2(q));
+#endif
+}
+
+// Branch-free helpers the CPU compiler turns into max/min/and instructions
+// (std::fmax's NaN rules would stop it vectorising).
+EMOFACE_HD EMOFACE_INLINE float max0(float x) { return x > 0.0f ? x : 0.0f; }
+EMOFACE_HD EMOFACE_INLINE float absf(float x) { return x < 0.0f ? -x : x; }
+EMOFACE_HD EMOFACE_INLINE float clampf(float x, float lo, float hi) {
+    // NaN compares false both ways and ends up at lo: never an out-of-range index.
+    return x > lo ? (x < hi ? x : hi) : lo;
+}
+
+template <Law L>
+EMOFACE_HD EMOFACE_INLINE float line_weight(float q, float b) {
+    if constexpr (L == Law::InverseSquare) {
+        const float r = fast_rcp(q);
+        return r * r;
+    } else {
+        return pow_neg(q, b);
+    }
+}
+
+// ---- per pixel-line accumulation ------------------------------------------
+
+// Sums for PX points on one row: Σw and Σ w·D_k (iso units).
+template <int K, int PX>
+struct Accum {
+    float w[PX];
+    float dx[K][PX];
+    float dy[K][PX];
+
+    EMOFACE_HD EMOFACE_INLINE void clear() {
+        EMOFACE_PIXEL_LOOP
+        for (int j = 0; j < PX; ++j) w[j] = 0.0f;
+        EMOFACE_UNROLL
+        for (int k = 0; k < K; ++k) {
+            EMOFACE_PIXEL_LOOP
+            for (int j = 0; j < PX; ++j) {
+                dx[k][j] = 0.0f;
+                dy[k][j] = 0.0f;
+            }
+        }
+    }
+};
+
+// Adds one line's contribution to PX points (x0 + j·step, y), j = 0..PX-1,
+// in iso units. `rec` is one line record with K sources. u, v and w are
+// computed once per point and reused for every source.
+template <int K, int PX, Law L>
+EMOFACE_HD EMOFACE_INLINE void accumulate_line(const float* rec, float x0, float y, float step,
+                                               float b, Accum<K, PX>& acc) {
+    const float ex = rec[kEx], ey = rec[kEy];
+    const float nx = rec[kNx], ny = rec[kNy];
+    const float half_len = rec[kHalfLen], wk = rec[kWk], wa = rec[kWa];
+    const float s0 = x0 * ex + (y * ey + rec[kCs]);
+    const float v0 = x0 * nx + (y * ny + rec[kCv]);
+    const float s_step = step * ex;
+    const float v_step = step * nx;
+    const float* src = rec + kGeomFloats;
+    EMOFACE_PIXEL_LOOP
+    for (int j = 0; j < PX; ++j) {
+        const float s = s0 + static_cast<float>(j) * s_step;
+        const float v = v0 + static_cast<float>(j) * v_step;
+        const float beyond = max0(absf(s) - half_len);
+        const float dist = fast_sqrt(v * v + beyond * beyond);
+        const float w = line_weight<L>(dist * wk + wa, b);
+        acc.w[j] += w;
+        EMOFACE_UNROLL
+        for (int k = 0; k < K; ++k) {
+            const float* c = src + kSourceFloats * k;
+            acc.dx[k][j] += w * (c[0] + s * c[2] + v * c[4]);
+            acc.dy[k][j] += w * (c[1] + s * c[3] + v * c[5]);
+        }
+    }
+}
+
+// Displacement of point j for source k, in pixels: Σ w D / Σ w scaled by S.
+// With no lines (Σw = 0) the warp is the identity.
+template <int K, int PX>
+EMOFACE_HD EMOFACE_INLINE void displacement(const Accum<K, PX>& acc, int j, float extent,
+                                            float (&dx)[K], float (&dy)[K]) {
+    const float scale = acc.w[j] > 0.0f ? extent / acc.w[j] : 0.0f;
+    EMOFACE_UNROLL
+    for (int k = 0; k < K; ++k) {
+        dx[k] = acc.dx[k][j] * scale;
+        dy[k] = acc.dy[k][j] * scale;
+    }
+}
+
+// ---- sampling and blending --------------------------------------------------
+
+// A key map in memory: rows of `pitch` bytes, RGBA8 (4 bytes a pixel) or
+// RGBA float (16 bytes a pixel).
+struct ImageView {
+    const unsigned char* base;
+    std::size_t pitch;
+    int width, height;
+    bool is_float;
+};
+
+EMOFACE_HD EMOFACE_INLINE Rgba load_texel(const ImageView& img, int x, int y) {
+    const unsigned char* row = img.base + static_cast<std::size_t>(y) * img.pitch;
+    if (img.is_float) {
+        const float* p = reinterpret_cast<const float*>(row) + 4 * x;
+        return {p[0], p[1], p[2], p[3]};
+    }
+    const unsigned char* p = row + 4 * x;
+    return {static_cast<float>(p[0]), static_cast<float>(p[1]), static_cast<float>(p[2]),
+            static_cast<float>(p[3])};
+}
+
+EMOFACE_HD EMOFACE_INLINE float lerp2(float p, float q, float r, float s, float tx, float ty) {
+    const float top = p + tx * (q - p);
+    const float bottom = r + tx * (s - r);
+    return top + ty * (bottom - top);
+}
+
+// Bilinear sample at pixel coordinates (px, py), pixel centres at i + 0.5,
+// clamped to the edge. RGBA8 values stay in 0..255 units.
+EMOFACE_HD EMOFACE_INLINE Rgba sample_bilinear(const ImageView& img, float px, float py) {
+    const float fx = clampf(px - 0.5f, 0.0f, static_cast<float>(img.width - 1));
+    const float fy = clampf(py - 0.5f, 0.0f, static_cast<float>(img.height - 1));
+    const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
+    const int x1 = x0 + 1 < img.width ? x0 + 1 : x0;
+    const int y1 = y0 + 1 < img.height ? y0 + 1 : y0;
+    const float tx = fx - static_cast<float>(x0), ty = fy - static_cast<float>(y0);
+    const Rgba a = load_texel(img, x0, y0), b = load_texel(img, x1, y0);
+    const Rgba c = load_texel(img, x0, y1), d = load_texel(img, x1, y1);
+    return {lerp2(a.r, b.r, c.r, d.r, tx, ty), lerp2(a.g, b.g, c.g, d.g, tx, ty),
+            lerp2(a.b, b.b, c.b, d.b, tx, ty), lerp2(a.a, b.a, c.a, d.a, tx, ty)};
+}
+
+EMOFACE_HD EMOFACE_INLINE void add_weighted(Rgba& sum, const Rgba& c, float w) {
+    sum.r += w * c.r;
+    sum.g += w * c.g;
+    sum.b += w * c.b;
+    sum.a += w * c.a;
+}
+
+// A normal map stores 0.5 + 0.5 n (times 255 for RGBA8). The blend of unit
+// vectors is shorter than 1; renormalise it and keep the encoding. A blend that
+// cancels out (or no source at all) gives the flat normal +z.
+EMOFACE_HD EMOFACE_INLINE Rgba renormalise(Rgba c, float unit) {
+    const float inv_unit = 1.0f / unit;
+    float nx = 2.0f * c.r * inv_unit - 1.0f;
+    float ny = 2.0f * c.g * inv_unit - 1.0f;
+    float nz = 2.0f * c.b * inv_unit - 1.0f;
+    const float len2 = nx * nx + ny * ny + nz * nz;
+    if (len2 > 1e-12f) {
+        const float inv = 1.0f / std::sqrt(len2);
+        nx *= inv;
+        ny *= inv;
+        nz *= inv;
+    } else {
+        nx = 0.0f;
+        ny = 0.0f;
+        nz = 1.0f;
+    }
+    return {(0.5f + 0.5f * nx) * unit, (0.5f + 0.5f * ny) * unit, (0.5f + 0.5f * nz) * unit, c.a};
+}
+
+EMOFACE_HD EMOFACE_INLINE unsigned char to_byte(float v) {
+    return static_cast<unsigned char>(clampf(v, 0.0f, 255.0f) + 0.5f);
+}
+
+// RGBA8 packed little-endian into one 32-bit word (r in the low byte).
+EMOFACE_HD EMOFACE_INLINE std::uint32_t pack_rgba8(const Rgba& c) {
+    return static_cast<std::uint32_t>(to_byte(c.r)) |
+           (static_cast<std::uint32_t>(to_byte(c.g)) << 8) |
+           (static_cast<std::uint32_t>(to_byte(c.b)) << 16) |
+           (static_cast<std::uint32_t>(to_byte(c.a)) << 24);
+}
+
+// Samples the K sources at X + D_k and blends them by weight: the per-pixel
+// end of the kernel, after the line loop.
+template <int K>
+EMOFACE_HD EMOFACE_INLINE Rgba blend_sources(const ImageView* keys, const float* weights, float px, float py, const float (&dx)[K],
+                                             const float (&dy)[K], bool normal_map) {
+    Rgba sum{0.0f, 0.0f, 0.0f, 0.0f};
+    EMOFACE_UNROLL
+    for (int k = 0; k < K; ++k) add_weighted(sum, sample_bilinear(keys[k], px + dx[k], py + dy[k]), weights[k]);
+    if (normal_map) sum = renormalise(sum, keys[0].is_float ? 1.0f : 255.0f);
+    return sum;
+}
+
+}  // namespace emoface::morph::kernel

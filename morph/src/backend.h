@@ -1,0 +1,61 @@
+#pragma once
+// What the Morpher front end hands a backend each frame, and the backend
+// interface. The front end validates input and builds the line table; a
+// backend only runs it.
+#include <cstddef>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "emoface/morph/kernel.h"
+#include "emoface/morph/morph.h"
+
+namespace emoface::morph::detail {
+
+// One frame, ready to run: the sources taking part (weight > 0, or all of
+// them for positions), their weights, and the line table with one record of
+// kernel::record_floats(sources) floats per line.
+struct FramePlan {
+    int sources = 0;
+    int source_index[kernel::kMaxKeys] = {};
+    float weight[kernel::kMaxKeys] = {};
+    int lines = 0;
+    int record_floats = 0;
+    const float* records = nullptr;
+    kernel::Law law = kernel::Law::InverseSquare;
+    float b = 2.0f;
+    bool normal_map = false;
+    Accuracy accuracy = Accuracy::Exact;
+    int fast_cell = 8;
+    float extent = 1.0f;      // S = max(W, H): iso units to pixels
+    float inv_extent = 1.0f;  // 1 / S
+};
+
+struct OutputTarget {
+    enum class Kind { Host, Device, Surface, Positions };
+    Kind kind = Kind::Host;
+    void* ptr = nullptr;            // Host/Device: pixels; Positions: host floats
+    std::size_t pitch = 0;          // bytes a row (Host, Device)
+    unsigned long long surface = 0; // Surface
+};
+
+class BackendImpl {
+public:
+    virtual ~BackendImpl() = default;
+    virtual void run(const FramePlan& plan, const OutputTarget& target) = 0;
+    virtual void synchronize() {}
+    virtual void* stream() const { return nullptr; }
+    virtual SetupTimes setup_times() const = 0;
+};
+
+// keys: validated, all width x height of `format`.
+std::unique_ptr<BackendImpl> make_cpu_backend(int width, int height, PixelFormat format,
+                                              const std::vector<KeyMap>& keys);
+#if defined(EMOFACE_MORPH_CUDA)
+std::unique_ptr<BackendImpl> make_cuda_backend(int width, int height, PixelFormat format,
+                                               const std::vector<KeyMap>& keys);
+bool cuda_device_usable(std::string* why);
+std::string cuda_describe_device();
+#endif
+
+}  // namespace emoface::morph::detail

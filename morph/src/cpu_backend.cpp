@@ -1,0 +1,90 @@
+// The CPU backend: the key maps copied once, the shared kernel body run over
+// rows by a thread pool with one thread per core.
+#include <chrono>
+#include <cstring>
+#include <vector>
+
+#include "backend.h"
+#include "cpu_kernels.h"
+#include "thread_pool.h"
+
+namespace emoface::morph::detail {
+namespace {
+
+const CpuKernels& pick_kernels() {
+#if defined(EMOFACE_MORPH_HAVE_AVX2) && (defined(__x86_64__) || defined(__i386__))
+    if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return cpu_avx2::kernels();
+#endif
+    return cpu_base::kernels();
+}
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+class CpuBackend final : public BackendImpl {
+public:
+    CpuBackend(int width, int height, PixelFormat format, const std::vector<KeyMap>& keys)
+        : width_(width), height_(height), is_float_(format == PixelFormat::RgbaF32),
+          kernels_(pick_kernels()) {
+        const std::size_t bytes = static_cast<std::size_t>(width) * height * (is_float_ ? 16 : 4);
+        auto t0 = Clock::now();
+        keys_.resize(keys.size());
+        for (auto& k : keys_) k.resize(bytes);
+        times_.allocate_ms = ms_since(t0);
+        t0 = Clock::now();
+        for (std::size_t k = 0; k < keys.size(); ++k) std::memcpy(keys_[k].data(), keys[k].pixels, bytes);
+        times_.upload_ms = ms_since(t0);
+    }
+
+    SetupTimes setup_times() const override { return times_; }
+
+    void run(const FramePlan& plan, const OutputTarget& target) override {
+        CpuJob job;
+        job.plan = &plan;
+        job.width = width_;
+        job.height = height_;
+        for (int i = 0; i < plan.sources; ++i)
+            job.keys[i] = {keys_[plan.source_index[i]].data(),
+                           static_cast<std::size_t>(width_) * (is_float_ ? 16 : 4), width_, height_, is_float_};
+        if (target.kind == OutputTarget::Kind::Positions) {
+            job.positions = static_cast<float*>(target.ptr);
+        } else {
+            job.out = static_cast<unsigned char*>(target.ptr);
+            job.out_pitch = target.pitch;
+        }
+
+        if (plan.accuracy == Accuracy::Exact) {
+            pool_.parallel_for(height_, 1, [&](int y0, int y1) { kernels_.exact_rows(job, y0, y1); });
+            return;
+        }
+        // Grid points i·cell cover pixel centres up to the last one, plus one
+        // more so every pixel lies inside a cell.
+        job.grid_w = (width_ - 1) / plan.fast_cell + 2;
+        job.grid_h = (height_ - 1) / plan.fast_cell + 2;
+        const std::size_t grid_floats = static_cast<std::size_t>(job.grid_w) * job.grid_h * 2 * plan.sources;
+        if (grid_.size() < grid_floats) grid_.resize(grid_floats);  // first use / finer cell only
+        job.grid = grid_.data();
+        pool_.parallel_for(job.grid_h, 1, [&](int g0, int g1) { kernels_.grid_rows(job, g0, g1); });
+        pool_.parallel_for(height_, 4, [&](int y0, int y1) { kernels_.apply_rows(job, y0, y1); });
+    }
+
+private:
+    int width_, height_;
+    bool is_float_;
+    const CpuKernels& kernels_;
+    std::vector<std::vector<unsigned char>> keys_;
+    std::vector<float> grid_;
+    ThreadPool pool_;
+    SetupTimes times_;
+};
+
+}  // namespace
+
+std::unique_ptr<BackendImpl> make_cpu_backend(int width, int height, PixelFormat format,
+                                              const std::vector<KeyMap>& keys) {
+    return std::make_unique<CpuBackend>(width, height, format, keys);
+}
+
+}  // namespace emoface::morph::detail

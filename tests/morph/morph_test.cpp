@@ -1,0 +1,520 @@
+// morph on the CPU backend: identities, analytic maps, blending, normal maps,
+// agreement with the double-precision reference, the fast mode, bad input.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "emoface/common/error.h"
+#include "emoface/morph/morph.h"
+#include "emoface/morph/reference.h"
+#include "morph_test_util.h"
+
+namespace emoface::morph {
+namespace {
+
+using namespace test;
+
+KeyMap key(const void* pixels, Layout layout) {
+    KeyMap k;
+    k.pixels = pixels;
+    k.layout = std::move(layout);
+    return k;
+}
+
+// Double bilinear sample, clamp to edge, pixel centres at i + 0.5: what the
+// output must hold where the warp sends a pixel to (px, py).
+double sample(const std::vector<std::uint8_t>& img, int w, int h, double px, double py, int c) {
+    const double fx = std::fmin(std::fmax(px - 0.5, 0.0), w - 1.0);
+    const double fy = std::fmin(std::fmax(py - 0.5, 0.0), h - 1.0);
+    const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
+    const int x1 = std::min(x0 + 1, w - 1), y1 = std::min(y0 + 1, h - 1);
+    const double tx = fx - x0, ty = fy - y0;
+    auto at = [&](int x, int y) { return static_cast<double>(img[(static_cast<std::size_t>(y) * w + x) * 4 + c]); };
+    return (1 - ty) * ((1 - tx) * at(x0, y0) + tx * at(x1, y0)) + ty * ((1 - tx) * at(x0, y1) + tx * at(x1, y1));
+}
+
+// ---- identity ----------------------------------------------------------------
+
+TEST(MorphIdentity, TargetEqualToSourceGivesTheSourceBack) {
+    const int w = 64, h = 48;
+    const auto img = random_rgba8(w, h, 1);
+    const Layout layout = random_layout(12, 2);
+    Morpher m(w, h, PixelFormat::Rgba8, {key(img.data(), layout)}, Backend::Cpu);
+    std::vector<std::uint8_t> out(img.size());
+    for (Accuracy acc : {Accuracy::Exact, Accuracy::Fast}) {
+        MorphParams params;
+        params.accuracy = acc;
+        m.morph_to_host(layout, {1.0f}, params, out.data());
+        // The displacement is exactly 0 (the line table holds exact zeros), so
+        // every pixel samples its own centre: not even rounding differs.
+        EXPECT_EQ(max_abs_diff(out, img), 0.0) << to_string(acc);
+    }
+}
+
+TEST(MorphIdentity, FloatKeysAndSeveralSourcesBlendInPlace) {
+    const int w = 40, h = 40;
+    const auto a = to_float(random_rgba8(w, h, 3)), b = to_float(random_rgba8(w, h, 4)),
+               c = to_float(random_rgba8(w, h, 5));
+    const Layout layout = random_layout(7, 6);
+    Morpher m(w, h, PixelFormat::RgbaF32, {key(a.data(), layout), key(b.data(), layout), key(c.data(), layout)},
+              Backend::Cpu);
+    std::vector<float> out(a.size());
+    m.morph_to_host(layout, {0.2f, 0.3f, 0.5f}, {}, out.data());
+    std::vector<float> expected(a.size());
+    for (std::size_t i = 0; i < a.size(); ++i) expected[i] = 0.2f * a[i] + 0.3f * b[i] + 0.5f * c[i];
+    EXPECT_LT(max_abs_diff(out, expected), 1e-6);
+}
+
+// ---- analytic maps -------------------------------------------------------------
+
+struct AnalyticCase {
+    const char* name;
+    int width, height;
+    Layout target;
+    Layout source;
+    std::function<void(double x, double y, double& sx, double& sy)> map;  // pixel coordinates
+};
+
+Layout horizontal_lines(int n, unsigned seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> pos(0.1f, 0.9f), len(0.1f, 0.3f);
+    Layout l;
+    for (int i = 0; i < n; ++i) {
+        const float x = pos(rng), y = pos(rng);
+        l.push_back({x, y, x + len(rng), y});
+    }
+    return l;
+}
+
+std::vector<AnalyticCase> analytic_cases() {
+    std::vector<AnalyticCase> cases;
+    {  // translation by (5, -3) pixels on a non-square image
+        const int w = 80, h = 50;
+        const Layout t = random_layout(10, 11);
+        Layout s = t;
+        for (Line& l : s) {
+            l.px += 5.0f / w;
+            l.qx += 5.0f / w;
+            l.py -= 3.0f / h;
+            l.qy -= 3.0f / h;
+        }
+        cases.push_back({"translation", w, h, t, s, [](double x, double y, double& sx, double& sy) {
+                             sx = x + 5.0;
+                             sy = y - 3.0;
+                         }});
+    }
+    {  // rotation by 20 degrees about the centre
+        const int w = 64, h = 64;
+        const Layout t = random_layout(10, 12);
+        const double th = 20.0 * 3.14159265358979 / 180.0, c = std::cos(th), s_ = std::sin(th);
+        auto rot = [=](float& x, float& y) {
+            const double dx = x - 0.5, dy = y - 0.5;
+            x = static_cast<float>(0.5 + c * dx - s_ * dy);
+            y = static_cast<float>(0.5 + s_ * dx + c * dy);
+        };
+        Layout s = t;
+        for (Line& l : s) {
+            rot(l.px, l.py);
+            rot(l.qx, l.qy);
+        }
+        cases.push_back({"rotation", w, h, t, s, [=](double x, double y, double& sx, double& sy) {
+                             const double dx = x - 32.0, dy = y - 32.0;
+                             sx = 32.0 + c * dx - s_ * dy;
+                             sy = 32.0 + s_ * dx + c * dy;
+                         }});
+    }
+    {  // scaling by 1.25 along the lines (all horizontal) about x = 0.5.
+        // Beier-Neely keeps the distance across a line (v) unscaled, so a
+        // uniform scale is reproduced only on the lines; along the lines'
+        // direction it is exact everywhere.
+        const int w = 64, h = 40;
+        const Layout t = horizontal_lines(8, 13);
+        Layout s = t;
+        for (Line& l : s) {
+            l.px = 0.5f + 1.25f * (l.px - 0.5f);
+            l.qx = 0.5f + 1.25f * (l.qx - 0.5f);
+        }
+        cases.push_back({"scaling along the lines", w, h, t, s, [](double x, double y, double& sx, double& sy) {
+                             sx = 32.0 + 1.25 * (x - 32.0);
+                             sy = y;
+                         }});
+    }
+    return cases;
+}
+
+TEST(MorphAnalytic, SimilarityOfAllLinesMovesTheImageAccordingly) {
+    for (const AnalyticCase& c : analytic_cases()) {
+        SCOPED_TRACE(c.name);
+        const auto img = random_rgba8(c.width, c.height, 21);
+        Morpher m(c.width, c.height, PixelFormat::Rgba8, {key(img.data(), c.source)}, Backend::Cpu);
+        std::vector<float> pos(static_cast<std::size_t>(c.width) * c.height * 2);
+        m.positions_to_host(c.target, {}, pos.data());
+        std::vector<std::uint8_t> out(img.size());
+        m.morph_to_host(c.target, {1.0f}, {}, out.data());
+        double worst_pos = 0.0, worst_value = 0.0;
+        for (int y = 0; y < c.height; ++y)
+            for (int x = 0; x < c.width; ++x) {
+                double sx, sy;
+                c.map(x + 0.5, y + 0.5, sx, sy);
+                const std::size_t i = static_cast<std::size_t>(y) * c.width + x;
+                worst_pos = std::fmax(worst_pos, std::hypot(pos[2 * i] - sx, pos[2 * i + 1] - sy));
+                for (int ch = 0; ch < 4; ++ch)
+                    worst_value = std::fmax(worst_value, std::fabs(out[4 * i + ch] - sample(img, c.width, c.height,
+                                                                                             sx, sy, ch)));
+            }
+        EXPECT_LT(worst_pos, 1e-3) << "pixels";
+        EXPECT_LE(worst_value, 1.0) << "LSB";
+    }
+}
+
+// ---- blending ----------------------------------------------------------------------
+
+TEST(MorphBlend, WeightsOneZeroEqualTheSingleSourceWarp) {
+    const int w = 48, h = 48;
+    const auto a = random_rgba8(w, h, 31), b = random_rgba8(w, h, 32);
+    const Layout la = random_layout(9, 33), lb = jitter(la, 0.05f, 34), target = jitter(la, 0.04f, 35);
+    Morpher two(w, h, PixelFormat::Rgba8, {key(a.data(), la), key(b.data(), lb)}, Backend::Cpu);
+    Morpher one(w, h, PixelFormat::Rgba8, {key(a.data(), la)}, Backend::Cpu);
+    std::vector<std::uint8_t> out2(a.size()), out1(a.size());
+    for (Accuracy acc : {Accuracy::Exact, Accuracy::Fast}) {
+        MorphParams params;
+        params.accuracy = acc;
+        two.morph_to_host(target, {1.0f, 0.0f}, params, out2.data());
+        one.morph_to_host(target, {1.0f}, params, out1.data());
+        EXPECT_EQ(max_abs_diff(out2, out1), 0.0) << to_string(acc);
+    }
+}
+
+TEST(MorphBlend, WeightsSummingToOneBlendTheWarpedSources) {
+    const int w = 48, h = 40;
+    const auto a = to_float(random_rgba8(w, h, 41)), b = to_float(random_rgba8(w, h, 42));
+    const Layout la = random_layout(9, 43), lb = jitter(la, 0.05f, 44), target = jitter(la, 0.04f, 45);
+    Morpher m(w, h, PixelFormat::RgbaF32, {key(a.data(), la), key(b.data(), lb)}, Backend::Cpu);
+    std::vector<float> wa(a.size()), wb(a.size()), mix(a.size());
+    m.morph_to_host(target, {1.0f, 0.0f}, {}, wa.data());
+    m.morph_to_host(target, {0.0f, 1.0f}, {}, wb.data());
+    for (float t : {0.25f, 0.5f, 0.9f}) {
+        m.morph_to_host(target, {1.0f - t, t}, {}, mix.data());
+        std::vector<float> expected(a.size());
+        for (std::size_t i = 0; i < a.size(); ++i) expected[i] = (1.0f - t) * wa[i] + t * wb[i];
+        EXPECT_LT(max_abs_diff(mix, expected), 1e-5) << "t = " << t;
+    }
+}
+
+TEST(MorphBlend, NormalMapsStayUnitLength) {
+    const int w = 40, h = 32;
+    const auto n0 = random_normals(w, h, 51), n1 = random_normals(w, h, 52), n2 = random_normals(w, h, 53);
+    const auto q0 = quantise(n0), q1 = quantise(n1), q2 = quantise(n2);
+    const Layout l0 = random_layout(8, 54), l1 = jitter(l0, 0.05f, 55), l2 = jitter(l0, 0.05f, 56);
+    const Layout target = jitter(l0, 0.03f, 57);
+    MorphParams params;
+    params.normal_map = true;
+    const std::vector<float> weights{0.3f, 0.3f, 0.4f};
+    struct Case {
+        PixelFormat format;
+        const void* k0;
+        const void* k1;
+        const void* k2;
+        double unit, tolerance;  // RGBA8: each component rounds by half an LSB
+    };
+    for (const Case& c : {Case{PixelFormat::RgbaF32, n0.data(), n1.data(), n2.data(), 1.0, 1e-5},
+                          Case{PixelFormat::Rgba8, q0.data(), q1.data(), q2.data(), 255.0, 0.01}}) {
+        SCOPED_TRACE(to_string(c.format));
+        for (Accuracy acc : {Accuracy::Exact, Accuracy::Fast}) {
+            params.accuracy = acc;
+            Morpher m(w, h, c.format, {key(c.k0, l0), key(c.k1, l1), key(c.k2, l2)}, Backend::Cpu);
+            std::vector<float> fout(static_cast<std::size_t>(w) * h * 4);
+            std::vector<std::uint8_t> bout(fout.size());
+            void* out = c.format == PixelFormat::RgbaF32 ? static_cast<void*>(fout.data()) : bout.data();
+            m.morph_to_host(target, weights, params, out);
+            double worst = 0.0;
+            for (std::size_t i = 0; i < fout.size() / 4; ++i) {
+                double n2sum = 0.0;
+                for (int ch = 0; ch < 3; ++ch) {
+                    const double v = c.format == PixelFormat::RgbaF32 ? fout[4 * i + ch] : bout[4 * i + ch];
+                    const double comp = 2.0 * v / c.unit - 1.0;
+                    n2sum += comp * comp;
+                }
+                worst = std::fmax(worst, std::fabs(std::sqrt(n2sum) - 1.0));
+            }
+            EXPECT_LT(worst, c.tolerance) << to_string(acc);
+        }
+    }
+}
+
+// ---- against the double reference ---------------------------------------------
+
+struct ReferenceCase {
+    const char* name;
+    int width, height, keys, lines;
+    float a, b, p;
+};
+
+class MorphReference : public ::testing::TestWithParam<ReferenceCase> {};
+
+TEST_P(MorphReference, PositionsWithin1e3PixelAndPixelsWithin1Lsb) {
+    const ReferenceCase& c = GetParam();
+    std::vector<std::vector<std::uint8_t>> images;
+    std::vector<KeyMap> keys;
+    std::vector<Layout> layouts;
+    const Layout base = random_layout(c.lines, 61);
+    for (int k = 0; k < c.keys; ++k) {
+        images.push_back(random_rgba8(c.width, c.height, 62 + k));
+        layouts.push_back(jitter(base, 0.06f, 70 + k));
+    }
+    for (int k = 0; k < c.keys; ++k) keys.push_back(key(images[k].data(), layouts[k]));
+    const Layout target = jitter(base, 0.04f, 80);
+    MorphParams params;
+    params.a = c.a;
+    params.b = c.b;
+    params.p = c.p;
+    std::vector<float> weights(c.keys, 1.0f / c.keys);
+
+    Morpher m(c.width, c.height, PixelFormat::Rgba8, keys, Backend::Cpu);
+    std::vector<float> pos(static_cast<std::size_t>(c.width) * c.height * c.keys * 2);
+    m.positions_to_host(target, params, pos.data());
+    std::vector<double> ref_pos;
+    reference_positions(c.width, c.height, layouts, target, params, ref_pos);
+    double worst = 0.0;
+    for (std::size_t i = 0; i < pos.size(); ++i) worst = std::fmax(worst, std::fabs(pos[i] - ref_pos[i]));
+    EXPECT_LT(worst, 1e-3) << "pixels";
+
+    std::vector<std::uint8_t> out(images[0].size()), ref(images[0].size());
+    m.morph_to_host(target, weights, params, out.data());
+    reference_morph(c.width, c.height, PixelFormat::Rgba8, keys, target, weights, params, ref.data());
+    EXPECT_LE(max_abs_diff(out, ref), 1.0) << "LSB";
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, MorphReference,
+    ::testing::Values(ReferenceCase{"square_K1", 64, 64, 1, 12, 0.01f, 2.0f, 0.5f},
+                      ReferenceCase{"wide_K3", 96, 40, 3, 10, 0.01f, 2.0f, 0.5f},
+                      ReferenceCase{"tall_K2_b1p3", 36, 70, 2, 9, 0.02f, 1.3f, 0.0f},
+                      ReferenceCase{"K8_p1", 32, 32, 8, 6, 0.005f, 2.0f, 1.0f},
+                      ReferenceCase{"sharp_a_b0p5", 50, 50, 2, 15, 0.001f, 0.5f, 0.7f}),
+    [](const auto& info) { return std::string(info.param.name); });
+
+TEST(MorphReferenceFloat, FloatKeysMatchTheReference) {
+    const int w = 48, h = 36;
+    const auto a = to_float(random_rgba8(w, h, 91)), b = to_float(random_rgba8(w, h, 92));
+    const Layout la = random_layout(8, 93), lb = jitter(la, 0.05f, 94), target = jitter(la, 0.03f, 95);
+    const std::vector<KeyMap> keys{key(a.data(), la), key(b.data(), lb)};
+    Morpher m(w, h, PixelFormat::RgbaF32, keys, Backend::Cpu);
+    std::vector<float> out(a.size()), ref(a.size());
+    m.morph_to_host(target, {0.6f, 0.4f}, {}, out.data());
+    reference_morph(w, h, PixelFormat::RgbaF32, keys, target, {0.6f, 0.4f}, {}, ref.data());
+    EXPECT_LT(max_abs_diff(out, ref), 1e-4);
+}
+
+// ---- fast mode -------------------------------------------------------------------------
+
+TEST(MorphFast, AffineFieldsAreInterpolatedExactly) {
+    // A translation makes every line's displacement the same constant, so the
+    // grid interpolates it without error.
+    const AnalyticCase c = analytic_cases()[0];
+    const auto img = random_rgba8(c.width, c.height, 101);
+    Morpher m(c.width, c.height, PixelFormat::Rgba8, {key(img.data(), c.source)}, Backend::Cpu);
+    std::vector<float> exact(static_cast<std::size_t>(c.width) * c.height * 2), fast(exact.size());
+    MorphParams params;
+    m.positions_to_host(c.target, params, exact.data());
+    params.accuracy = Accuracy::Fast;
+    for (int cell : {4, 8, 16, 32}) {
+        params.fast_cell = cell;
+        m.positions_to_host(c.target, params, fast.data());
+        EXPECT_LT(max_abs_diff(exact, fast), 1e-3) << "cell " << cell;
+    }
+}
+
+TEST(MorphFast, ErrorShrinksWithTheCellAndMatchesTheGridAtGridPoints) {
+    const int w = 128, h = 128;
+    const auto img = random_rgba8(w, h, 111);
+    const Layout base = random_layout(12, 112), target = jitter(base, 0.03f, 113);
+    Morpher m(w, h, PixelFormat::Rgba8, {key(img.data(), base)}, Backend::Cpu);
+    std::vector<float> exact(static_cast<std::size_t>(w) * h * 2), fast(exact.size());
+    MorphParams params;
+    m.positions_to_host(target, params, exact.data());
+    params.accuracy = Accuracy::Fast;
+    double previous = 1e9;
+    for (int cell : {32, 8}) {
+        params.fast_cell = cell;
+        m.positions_to_host(target, params, fast.data());
+        double worst = 0.0, at_grid = 0.0;
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const std::size_t i = (static_cast<std::size_t>(y) * w + x) * 2;
+                const double e = std::hypot(fast[i] - exact[i], fast[i + 1] - exact[i + 1]);
+                worst = std::fmax(worst, e);
+                if (x % cell == 0 && y % cell == 0) at_grid = std::fmax(at_grid, e);
+            }
+        EXPECT_LT(at_grid, 1e-3) << "cell " << cell << ": grid points are evaluated exactly";
+        EXPECT_LT(worst, previous) << "cell " << cell;
+        previous = worst;
+    }
+}
+
+// ---- backends ------------------------------------------------------------------------
+
+TEST(MorphBackend, AutoFallsBackToTheCpuWithoutADevice) {
+    if (cuda_available()) GTEST_SKIP() << "a CUDA device is present: " << cuda_device_description();
+    const auto img = random_rgba8(8, 8, 121);
+    Morpher m(8, 8, PixelFormat::Rgba8, {key(img.data(), random_layout(2, 122))});
+    EXPECT_EQ(m.backend(), Backend::Cpu);
+}
+
+TEST(MorphBackend, CudaWithoutADeviceIsAnEnvironmentErrorNamingTheFix) {
+    if (cuda_available()) GTEST_SKIP() << "a CUDA device is present: " << cuda_device_description();
+    const auto img = random_rgba8(8, 8, 123);
+    try {
+        Morpher m(8, 8, PixelFormat::Rgba8, {key(img.data(), random_layout(2, 124))}, Backend::Cuda);
+        FAIL() << "expected an EnvironmentError";
+    } catch (const EnvironmentError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("morph: Morpher(): Backend::Cuda asked for, but"), std::string::npos) << what;
+        EXPECT_NE(what.find("Backend::Cpu"), std::string::npos) << what;
+    }
+}
+
+TEST(MorphBackend, ResultsDoNotDependOnTheThreadSchedule) {
+    const int w = 70, h = 53;
+    const auto img = random_rgba8(w, h, 131);
+    const Layout base = random_layout(10, 132), target = jitter(base, 0.05f, 133);
+    Morpher m(w, h, PixelFormat::Rgba8, {key(img.data(), base)}, Backend::Cpu);
+    std::vector<std::uint8_t> first(img.size()), again(img.size());
+    m.morph_to_host(target, {1.0f}, {}, first.data());
+    for (int i = 0; i < 5; ++i) {
+        m.morph_to_host(target, {1.0f}, {}, again.data());
+        ASSERT_EQ(max_abs_diff(first, again), 0.0);
+    }
+}
+
+// ---- bad input -------------------------------------------------------------------------
+
+struct BadInput {
+    const char* name;
+    std::function<void()> action;
+    std::string message;  // the error must contain this
+};
+
+std::vector<BadInput> bad_inputs() {
+    static const auto img = random_rgba8(16, 16, 141);
+    static const Layout three = random_layout(3, 142);
+    const void* px = img.data();
+    auto morpher = [=] {
+        return Morpher(16, 16, PixelFormat::Rgba8, {key(px, three), key(px, three)}, Backend::Cpu);
+    };
+    auto frame = [=](Layout target, std::vector<float> weights, MorphParams params = {}) {
+        return [=] {
+            Morpher m = morpher();
+            std::vector<std::uint8_t> out(16 * 16 * 4);
+            m.morph_to_host(target, weights, params, out.data());
+        };
+    };
+    Layout zero_key = three;
+    zero_key[1] = {0.5f, 0.5f, 0.5f, 0.5f};
+    Layout nan_key = three;
+    nan_key[2].px = std::nanf("");
+    Layout zero_target = three;
+    zero_target[0].qx = zero_target[0].px;
+    zero_target[0].qy = zero_target[0].py;
+    Layout inf_target = three;
+    inf_target[2].qy = INFINITY;
+    MorphParams a0;
+    a0.a = 0.0f;
+    MorphParams bneg;
+    bneg.b = -1.0f;
+    MorphParams cell5;
+    cell5.accuracy = Accuracy::Fast;
+    cell5.fast_cell = 5;
+    KeyMap small = key(px, three);
+    small.width = 8;
+    small.height = 16;
+
+    return {
+        {"size zero", [=] { Morpher(0, 16, PixelFormat::Rgba8, {key(px, three)}, Backend::Cpu); },
+         "morph: Morpher(): size 0 x 16, expected width and height in 1..16384"},
+        {"size too large", [=] { Morpher(16, 20000, PixelFormat::Rgba8, {key(px, three)}, Backend::Cpu); },
+         "morph: Morpher(): size 16 x 20000, expected width and height in 1..16384"},
+        {"K = 0", [] { Morpher(16, 16, PixelFormat::Rgba8, {}, Backend::Cpu); },
+         "morph: Morpher(): K = 0 key maps, expected 1 to 8"},
+        {"K = 9", [=] { Morpher(16, 16, PixelFormat::Rgba8, std::vector<KeyMap>(9, key(px, three)), Backend::Cpu); },
+         "morph: Morpher(): K = 9 key maps, expected 1 to 8"},
+        {"null pixels", [=] { Morpher(16, 16, PixelFormat::Rgba8, {key(px, three), key(nullptr, three)}, Backend::Cpu); },
+         "morph: Morpher(): key 1 has no pixels (null pointer)"},
+        {"sizes differ", [=] { Morpher(16, 16, PixelFormat::Rgba8, {key(px, three), small}, Backend::Cpu); },
+         "morph: Morpher(): key 1 is 8 x 16, expected 16 x 16 (all key maps the same size)"},
+        {"line counts differ",
+         [=] { Morpher(16, 16, PixelFormat::Rgba8, {key(px, three), key(px, random_layout(2, 143))}, Backend::Cpu); },
+         "morph: Morpher(): key 1 layout has 2 lines, key 0 has 3 (every layout needs the same line count)"},
+        {"zero-length key line", [=] { Morpher(16, 16, PixelFormat::Rgba8, {key(px, zero_key)}, Backend::Cpu); },
+         "morph: Morpher(): key 0 line 1 has zero length: P = (0.5, 0.5), Q = (0.5, 0.5), expected P != Q"},
+        {"NaN key coordinate",
+         [=] { Morpher(16, 16, PixelFormat::Rgba8, {key(px, three), key(px, nan_key)}, Backend::Cpu); },
+         "morph: Morpher(): key 1 line 2 has a non-finite coordinate: P = (nan,"},
+        {"target line count", frame(random_layout(2, 144), {0.5f, 0.5f}),
+         "morph: morph_to_host(): target layout has 2 lines, expected 3 (the key layouts' count)"},
+        {"zero-length target line", frame(zero_target, {0.5f, 0.5f}),
+         "morph: morph_to_host(): target line 0 has zero length"},
+        {"infinite target coordinate", frame(inf_target, {0.5f, 0.5f}),
+         "morph: morph_to_host(): target line 2 has a non-finite coordinate"},
+        {"weight count", frame(three, {1.0f}), "morph: morph_to_host(): 1 weights, expected 2 (one per key map)"},
+        {"negative weight", frame(three, {0.5f, -0.25f}),
+         "morph: morph_to_host(): weight 1 is -0.25, expected a finite value >= 0"},
+        {"NaN weight", frame(three, {std::nanf(""), 0.5f}),
+         "morph: morph_to_host(): weight 0 is nan, expected a finite value >= 0"},
+        {"weights over 1", frame(three, {0.75f, 0.75f}), "morph: morph_to_host(): weights sum to 1.5, expected at most 1"},
+        {"a = 0", frame(three, {0.5f, 0.5f}, a0), "morph: morph_to_host(): params.a = 0, expected a finite value > 0"},
+        {"b < 0", frame(three, {0.5f, 0.5f}, bneg), "morph: morph_to_host(): params.b = -1, expected a value in [0, 16]"},
+        {"fast cell", frame(three, {0.5f, 0.5f}, cell5),
+         "morph: morph_to_host(): params.fast_cell = 5, expected 4, 8, 16 or 32"},
+        {"null output",
+         [=] {
+             Morpher m = morpher();
+             m.morph_to_host(three, {0.5f, 0.5f}, {}, nullptr);
+         },
+         "morph: morph_to_host(): out is null"},
+        {"device output on the CPU backend",
+         [=] {
+             Morpher m = morpher();
+             std::vector<std::uint8_t> out(16 * 16 * 4);
+             m.morph_to_device(three, {0.5f, 0.5f}, {}, out.data(), 64);
+         },
+         "morph: morph_to_device(): this Morpher runs on the cpu backend, expected Backend::Cuda"},
+        {"positions of a bad target",
+         [=] {
+             Morpher m = morpher();
+             std::vector<float> out(16 * 16 * 4);
+             m.positions_to_host(zero_target, {}, out.data());
+         },
+         "morph: positions_to_host(): target line 0 has zero length"},
+    };
+}
+
+TEST(MorphBadInput, EachBadInputIsAClearInputError) {
+    for (const BadInput& c : bad_inputs()) {
+        SCOPED_TRACE(c.name);
+        try {
+            c.action();
+            ADD_FAILURE() << "no error";
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find(c.message), std::string::npos)
+                << "got:      " << e.what() << "\nexpected: " << c.message;
+        }
+    }
+}
+
+TEST(MorphBadInput, ABadFrameLeavesTheMorpherUsable) {
+    const auto img = random_rgba8(16, 16, 151);
+    const Layout l = random_layout(3, 152);
+    Morpher m(16, 16, PixelFormat::Rgba8, {key(img.data(), l)}, Backend::Cpu);
+    std::vector<std::uint8_t> out(img.size());
+    EXPECT_THROW(m.morph_to_host(l, {2.0f}, {}, out.data()), InputError);
+    m.morph_to_host(l, {1.0f}, {}, out.data());
+    EXPECT_EQ(max_abs_diff(out, img), 0.0);
+}
+
+}  // namespace
+}  // namespace emoface::morph
