@@ -12,7 +12,28 @@ namespace emoface::render {
 
 using detail::check_gl;
 
+namespace {
+thread_local Platform* t_current = nullptr;
+}
+
 Platform::~Platform() = default;
+
+void Platform::make_current() {
+    if (t_current != this && t_current) t_current->unbind_context();
+    bind_context();
+    t_current = this;
+}
+
+void Platform::release_current() noexcept {
+    if (t_current) t_current->unbind_context();
+    t_current = nullptr;
+}
+
+void Platform::mark_current() noexcept { t_current = this; }
+
+void Platform::forget_current() noexcept {
+    if (t_current == this) t_current = nullptr;
+}
 
 bool Platform::is_software() const {
     return description_.find("llvmpipe") != std::string::npos ||

@@ -152,6 +152,7 @@ HeadlessPlatform::HeadlessPlatform(const PlatformOptions& options) {
             notes += " no EGL_MESA_platform_surfaceless;";
         }
     }
+    release_current();
     for (const Candidate& c : candidates) {
         EGLint major = 0, minor = 0;
         if (!eglInitialize(c.display, &major, &minor)) {
@@ -166,9 +167,11 @@ HeadlessPlatform::HeadlessPlatform(const PlatformOptions& options) {
         }
         display_ = c.display;
         context_ = ctx;
+        mark_current();
         try {
             init_gl(options.width, options.height, options.samples, c.name);
         } catch (...) {
+            forget_current();
             eglMakeCurrent(c.display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
             eglDestroyContext(c.display, ctx);
             release_display(c.display);
@@ -184,15 +187,21 @@ HeadlessPlatform::~HeadlessPlatform() {
     if (!context_) return;
     make_current();
     destroy_gl();
-    eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    unbind_context();
+    forget_current();
     eglDestroyContext(display_, context_);
     release_display(display_);
 }
 
-void HeadlessPlatform::make_current() {
+void HeadlessPlatform::bind_context() {
     if (eglGetCurrentContext() == context_) return;
     if (!eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_))
         fail<EnvironmentError>("render: eglMakeCurrent failed (0x{:x})", eglGetError());
+}
+
+void HeadlessPlatform::unbind_context() noexcept {
+    if (eglGetCurrentContext() == context_)
+        eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
 }
 
 }  // namespace emoface::render

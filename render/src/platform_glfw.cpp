@@ -58,7 +58,9 @@ WindowPlatform::WindowPlatform(const PlatformOptions& options) {
                                options.width, options.height,
                                g_glfw_error.empty() ? "glfwCreateWindow failed" : g_glfw_error);
     }
+    release_current();
     glfwMakeContextCurrent(window_);
+    mark_current();
     glfwSwapInterval(options.vsync ? 1 : 0);
     try {
         int fw = 0, fh = 0;
@@ -66,6 +68,8 @@ WindowPlatform::WindowPlatform(const PlatformOptions& options) {
         init_gl(fw > 0 ? fw : options.width, fh > 0 ? fh : options.height, options.samples,
                 "GLFW window");
     } catch (...) {
+        forget_current();
+        glfwMakeContextCurrent(nullptr);
         glfwDestroyWindow(window_);
         release_glfw();
         throw;
@@ -76,12 +80,18 @@ WindowPlatform::~WindowPlatform() {
     if (!window_) return;
     make_current();
     destroy_gl();
+    unbind_context();
+    forget_current();
     glfwDestroyWindow(window_);
     release_glfw();
 }
 
-void WindowPlatform::make_current() {
+void WindowPlatform::bind_context() {
     if (glfwGetCurrentContext() != window_) glfwMakeContextCurrent(window_);
+}
+
+void WindowPlatform::unbind_context() noexcept {
+    if (glfwGetCurrentContext() == window_) glfwMakeContextCurrent(nullptr);
 }
 
 void WindowPlatform::end_frame() {

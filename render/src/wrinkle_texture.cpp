@@ -95,4 +95,13 @@ void WrinkleTexture::upload(const void* pixels, std::size_t row_bytes) {
     detail::check_gl("WrinkleTexture::upload()");
 }
 
+void WrinkleTexture::download(void* pixels) const {
+    if (mapped()) fail("render: WrinkleTexture::download(): the texture is mapped for CUDA");
+    glBindTexture(GL_TEXTURE_2D, texture_);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, gl_format(format_).type, pixels);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    detail::check_gl("WrinkleTexture::download()");
+}
+
 }  // namespace emoface::render

@@ -48,7 +48,10 @@ public:
     const std::string& description() const { return description_; }
     bool is_software() const;  // llvmpipe / softpipe / swrast
 
-    virtual void make_current() = 0;
+    // Makes this platform's context current on the calling thread, first
+    // releasing another platform's (a GLX window's and an EGL context cannot
+    // both be current: EGL answers EGL_BAD_ACCESS).
+    void make_current();
     // Binds the multisampled draw framebuffer and sets the viewport to it.
     void begin_frame();
     // Resolves the draw framebuffer (and presents it, for a window).
@@ -62,6 +65,16 @@ public:
 
 protected:
     Platform() = default;
+    // Context switching, implemented per platform; make_current() calls them.
+    virtual void bind_context() = 0;
+    virtual void unbind_context() noexcept = 0;
+    // Releases whichever platform's context is current on this thread (before
+    // a constructor makes its new context current).
+    static void release_current() noexcept;
+    // Records that this platform's context was made current directly.
+    void mark_current() noexcept;
+    // For destructors: forgets this platform if it is the current one.
+    void forget_current() noexcept;
     // Called by subclasses once their context is current: loads GL through
     // epoxy, checks the version, creates the framebuffers.
     void init_gl(int width, int height, int samples, const std::string& platform_name);
@@ -80,7 +93,6 @@ public:
     // Throws emoface::EnvironmentError when no display can be opened.
     explicit WindowPlatform(const PlatformOptions& options);
     ~WindowPlatform() override;
-    void make_current() override;
     // Resolves, blits to the window (letterboxed to its current size) and swaps.
     void end_frame() override;
     bool should_close() const;
@@ -88,6 +100,9 @@ public:
     GLFWwindow* window() const { return window_; }
 
 private:
+    void bind_context() override;
+    void unbind_context() noexcept override;
+
     GLFWwindow* window_ = nullptr;
 };
 
@@ -97,9 +112,11 @@ public:
     // core context.
     explicit HeadlessPlatform(const PlatformOptions& options);
     ~HeadlessPlatform() override;
-    void make_current() override;
 
 private:
+    void bind_context() override;
+    void unbind_context() noexcept override;
+
     void* display_ = nullptr;  // EGLDisplay
     void* context_ = nullptr;  // EGLContext
 };

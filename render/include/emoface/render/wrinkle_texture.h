@@ -45,6 +45,10 @@ public:
     // format, rows top first, `row_bytes` apart; 0 = tightly packed).
     void upload(const void* pixels, std::size_t row_bytes = 0);
 
+    // Reads the whole texture back (for tests): width * height texels of
+    // this texture's format, rows top first. Waits for the GPU.
+    void download(void* pixels) const;
+
     // GPU path. register_cuda() is called once (map_surface() calls it when
     // needed); throws emoface::EnvironmentError without CUDA or a device.
     void register_cuda();
