@@ -16,7 +16,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Run {
+struct CommandResult {
     int rc;
     std::string out, err;
 };
@@ -36,7 +36,7 @@ protected:
     }
     void TearDown() override { fs::remove_all(dir_); }
 
-    Run run(const std::string& args) {
+    CommandResult run(const std::string& args) {
         const fs::path out = dir_ / "stdout", err = dir_ / "stderr";
         const std::string command = std::string("'") + EMOFACE_BINARY + "' " + args + " >'" +
                                     out.string() + "' 2>'" + err.string() + "'";
@@ -56,7 +56,7 @@ protected:
 const std::string kTour = std::string(EMOFACE_DATA_DIR) + "/fap/tour.fap";
 
 TEST_F(InfoCli, BundledTour) {
-    const Run r = run("info '" + kTour + "'");
+    const CommandResult r = run("info '" + kTour + "'");
     EXPECT_EQ(r.rc, 0) << r.err;
     EXPECT_EQ(r.err, "");
     EXPECT_NE(r.out.find("  version   2.1\n"), std::string::npos) << r.out;
@@ -70,7 +70,7 @@ TEST_F(InfoCli, BundledTour) {
 }
 
 TEST_F(InfoCli, Json) {
-    const Run r = run("info --json '" + kTour + "'");
+    const CommandResult r = run("info --json '" + kTour + "'");
     ASSERT_EQ(r.rc, 0) << r.err;
     const nlohmann::json j = nlohmann::json::parse(r.out);
     ASSERT_TRUE(j.is_array());
@@ -89,12 +89,12 @@ TEST_F(InfoCli, Json) {
 
 TEST_F(InfoCli, BadFileIsOneLineAndExitTwo) {
     const std::string bad = write("bad.fap", "2.1 anim 25 1\n1 0 0\n");
-    const Run r = run("info '" + bad + "'");
+    const CommandResult r = run("info '" + bad + "'");
     EXPECT_EQ(r.rc, 2);
     EXPECT_EQ(r.out, "");
     EXPECT_EQ(r.err, "emoface: fap: " + bad +
                          ":2: frame 1: expected a mask of 68 tokens (69 from Greta's Java writer), found 3\n");
-    const Run missing = run("info '" + (dir_ / "none.fap").string() + "'");
+    const CommandResult missing = run("info '" + (dir_ / "none.fap").string() + "'");
     EXPECT_EQ(missing.rc, 2);
     EXPECT_EQ(missing.err, "emoface: fap: " + (dir_ / "none.fap").string() +
                                ": expected a readable FAP file, found No such file or directory\n");
@@ -103,12 +103,12 @@ TEST_F(InfoCli, BadFileIsOneLineAndExitTwo) {
 TEST_F(InfoCli, SeveralFilesReportEveryGoodOneAndStillFail) {
     const std::string bad1 = write("bad1.fap", "junk\n");
     const std::string bad2 = write("bad2.fap", "");
-    const Run r = run("info '" + bad1 + "' '" + kTour + "' '" + bad2 + "'");
+    const CommandResult r = run("info '" + bad1 + "' '" + kTour + "' '" + bad2 + "'");
     EXPECT_EQ(r.rc, 2);
     EXPECT_NE(r.out.find("  frames    50 (numbered 0..49)\n"), std::string::npos);
     EXPECT_EQ(r.err, "emoface: fap: " + bad1 + ":1: expected a header `version name fps count`, found 'junk'\n" +
                          "emoface: fap: " + bad2 + ":1: expected a header line `version name fps count`, found end of file\n");
-    const Run j = run("info --json '" + bad1 + "' '" + kTour + "'");
+    const CommandResult j = run("info --json '" + bad1 + "' '" + kTour + "'");
     EXPECT_EQ(j.rc, 2);
     const nlohmann::json parsed = nlohmann::json::parse(j.out);
     ASSERT_EQ(parsed.size(), 2u);
@@ -122,7 +122,7 @@ TEST_F(InfoCli, RealFiles) {
     if (!fs::is_directory(real)) GTEST_SKIP() << "no real FAP files at " << real;
     std::string args = "info --json";
     for (const auto& e : fs::directory_iterator(real)) args += " '" + e.path().string() + "'";
-    const Run r = run(args);
+    const CommandResult r = run(args);
     ASSERT_EQ(r.rc, 0) << r.err;
     const nlohmann::json j = nlohmann::json::parse(r.out);
     int xface_emotions = 0;
