@@ -99,13 +99,20 @@ GLuint upload_srgb_texture(const ImageRGBA8& image) {
         image.pixels.size() != std::size_t(image.width) * image.height * 4)
         fail("render: base texture: {}x{} image with {} bytes, expected width*height*4",
              image.width, image.height, image.pixels.size());
+    // Mesh texcoords follow OBJ/OpenGL (v = 0 at the image's bottom row) and
+    // GL's first row is t = 0: upload the rows bottom first.
+    const std::size_t row = image.row_bytes();
+    std::vector<std::uint8_t> flipped(image.pixels.size());
+    for (int y = 0; y < image.height; ++y)
+        std::copy_n(image.pixels.data() + std::size_t(image.height - 1 - y) * row, row,
+                    flipped.data() + std::size_t(y) * row);
     GLuint t = 0;
     glGenTextures(1, &t);
     glBindTexture(GL_TEXTURE_2D, t);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
     glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
     glTexImage2D(GL_TEXTURE_2D, 0, GL_SRGB8_ALPHA8, image.width, image.height, 0, GL_RGBA,
-                 GL_UNSIGNED_BYTE, image.pixels.data());
+                 GL_UNSIGNED_BYTE, flipped.data());
     glGenerateMipmap(GL_TEXTURE_2D);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);

@@ -54,8 +54,10 @@ struct Camera {
 struct Material {
     // Linear RGB multiplied with the base texture (or used alone without one).
     glm::vec3 base_color{1.0f};
-    // sRGB-encoded base colour image sampled with the mesh's texcoords2D;
-    // null: base_color alone.
+    // sRGB-encoded base colour image (rows top first) sampled with the mesh's
+    // texcoords2D, which follow OBJ/OpenGL: v = 0 is the image's bottom row
+    // (unlike the wrinkle UVs, whose v runs down the image; see
+    // wrinkle_texture.h). null: base_color alone.
     std::shared_ptr<const ImageRGBA8> base_texture;
     // Whether this mesh is bump-mapped with the wrinkle map (skin: yes,
     // eyeballs: no).
