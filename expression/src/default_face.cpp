@@ -1,0 +1,811 @@
+// The default face generator. The skin is one grid over the whole head: the
+// columns are azimuths around the head's vertical axis (dense over the face,
+// sparse behind), the rows are rays swept from eye level up over the crown
+// and down over the face, under the chin and along the neck (data/face
+// face.json, resolution.upper_rows / lower_rows). Each grid vertex is where
+// its ray leaves the head volume, moved by the frontal relief.
+//
+// The eyes and the mouth are slits in that grid: along the eye row and the
+// mouth row, the vertices between the two corner columns are doubled, one copy
+// for the upper lid (lip) and one for the lower. The rows around each slit are
+// warped so the copies land on the eyelid margins (open) or on the line where
+// the lips meet (closed), and the rig can pull them apart.
+#include "emoface/expression/default_face.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "emoface/common/error.h"
+#include "emoface/fap/feature_points.h"
+#include "face_params.h"
+#include "face_shape.h"
+#include "face_texture.h"
+
+namespace emoface::expression {
+namespace {
+
+using detail::FaceParams;
+using detail::FaceShape;
+using detail::V3;
+using detail::length;
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDeg = kPi / 180.0;
+
+struct Row {
+    double origin_y = 0;
+    double z_front = 0, z_back = 0;
+    double angle_front = 0, angle_back = 0;  // radians
+
+    static double front_weight(double theta) { return 0.5 * (1.0 + std::cos(theta)); }
+    V3 origin(double theta) const { return {0.0, origin_y, detail::mix(z_back, z_front, front_weight(theta))}; }
+    double angle(double theta) const { return detail::mix(angle_back, angle_front, front_weight(theta)); }
+    bool same_origin(const Row& r) const {
+        return origin_y == r.origin_y && z_front == r.z_front && z_back == r.z_back;
+    }
+};
+
+V3 ray_dir(double theta, double phi) {
+    return {std::sin(theta) * std::cos(phi), std::sin(phi), std::cos(theta) * std::cos(phi)};
+}
+
+// Samples `count` steps from key a to key b (excluding a, including b).
+detail::RowKey lerp_key(const detail::RowKey& a, const detail::RowKey& b, double t) {
+    detail::RowKey k;
+    k.origin_y = detail::mix(a.origin_y, b.origin_y, t);
+    k.origin_z_front = detail::mix(a.origin_z_front, b.origin_z_front, t);
+    k.origin_z_back = detail::mix(a.origin_z_back, b.origin_z_back, t);
+    k.angle_front_deg = detail::mix(a.angle_front_deg, b.angle_front_deg, t);
+    k.angle_back_deg = detail::mix(a.angle_back_deg, b.angle_back_deg, t);
+    return k;
+}
+
+Row to_row(const detail::RowKey& k) {
+    return {k.origin_y, k.origin_z_front, k.origin_z_back, k.angle_front_deg * kDeg, k.angle_back_deg * kDeg};
+}
+
+void sweep(const detail::RowKey& a, const detail::RowKey& b, int count, std::vector<Row>& out) {
+    for (int s = 1; s <= count; ++s) out.push_back(to_row(lerp_key(a, b, static_cast<double>(s) / count)));
+}
+
+int scaled(int n, double scale, int minimum) {
+    return std::max(minimum, static_cast<int>(std::lround(n * scale)));
+}
+
+// Falloff of a row warp with the distance from the slit row, 1 at the slit
+// and 0 at `reach`; its slope stays below 1.5 / reach so rows never cross
+// while the slit offset is below reach / 1.5.
+double warp_falloff(double d, double reach) {
+    if (d >= reach) return 0.0;
+    return 1.0 - detail::smoothstep(0.0, 1.0, d / reach);
+}
+
+class Generator {
+public:
+    Generator(const FaceParams& params, const DefaultFaceOptions& options)
+        : p_(params), shape_(p_), scale_(options.resolution_scale) {}
+
+    Face build(int texture_size);
+
+private:
+    V3 base_point(double theta, const Row& row, double dphi) const {
+        const V3 o = row.origin(theta);
+        const V3 d = ray_dir(theta, row.angle(theta) + dphi);
+        return o + d * shape_.cast(o, d);
+    }
+    // The elevation offset that puts the face-row vertex of column theta
+    // (ray from the head centre) at height y = target(x).
+    template <typename Target>
+    double solve_offset(double theta, const Row& row, Target target) const {
+        double dphi = 0.0;
+        for (int it = 0; it < 12; ++it) {
+            const V3 p = base_point(theta, row, dphi);
+            const double err = p.y - target(p.x);
+            if (std::abs(err) < 1e-6) break;
+            const double h = 1e-4;
+            const V3 q = base_point(theta, row, dphi + h);
+            const double derr = ((q.y - target(q.x)) - err) / h;
+            if (std::abs(derr) < 1e-9) break;
+            dphi -= err / derr;
+        }
+        return dphi;
+    }
+
+    void make_columns();
+    void make_rows();
+    void compute_warps();
+    void build_skin(Face& face);
+    void build_eyeball(Face& face, int side);
+    void build_mouth_interior(Face& face);
+    void place_feature_points(Face& face);
+
+    int grid(int i, int j) const { return j * (ncols_ + 1) + i; }
+    TriMesh::VertexHandle add_vertex(Face& face, V3 p, double u, double v, VertexPart part) {
+        auto vh = face.mesh.add_vertex(TriMesh::Point(static_cast<float>(p.x), static_cast<float>(p.y),
+                                                      static_cast<float>(p.z)));
+        face.mesh.set_texcoord2D(vh, TriMesh::TexCoord2D(static_cast<float>(u), static_cast<float>(v)));
+        face.parts.push_back(part);
+        return vh;
+    }
+    // Adds a triangle wound so its normal points along `outward`.
+    void add_oriented(Face& face, int a, int b, int c, V3 outward) {
+        const auto pa = face.mesh.point(TriMesh::VertexHandle(a));
+        const auto pb = face.mesh.point(TriMesh::VertexHandle(b));
+        const auto pc = face.mesh.point(TriMesh::VertexHandle(c));
+        const auto n = (pb - pa) % (pc - pa);
+        if (n[0] * outward.x + n[1] * outward.y + n[2] * outward.z < 0) std::swap(b, c);
+        add_triangle(face, a, b, c);
+    }
+    void add_triangle(Face& face, int a, int b, int c) {
+        if (a == b || b == c || a == c) return;
+        auto fh = face.mesh.add_face(TriMesh::VertexHandle(a), TriMesh::VertexHandle(b), TriMesh::VertexHandle(c));
+        if (!fh.is_valid()) ++rejected_faces_;
+    }
+
+    const FaceParams& p_;
+    FaceShape shape_;
+    double scale_;
+
+    std::vector<double> theta_;  // ncols_ + 1 azimuths, first and last the same seam
+    int ncols_ = 0;
+    int centre_col_ = 0;
+    std::vector<Row> rows_;  // bottom (neck) to top (crown)
+    int eye_row_ = 0, mouth_row_ = 0, mouth_row_down_ = 0;
+    double mouth_angle_ = 0;
+    // Per column: elevation offsets of the rows above / below each slit.
+    std::vector<double> eye_up_, eye_lo_, mouth_dphi_;
+    int eye_in_col_ = 0, eye_out_col_ = 0;      // left eye (theta > 0)
+    int mouth_corner_col_ = 0;                  // left corner
+    std::vector<int> eye_lower_copy_, mouth_lower_copy_;  // per column, -1 if none
+    int pole_ = -1;
+    int rejected_faces_ = 0;
+    std::vector<V3> base_;  // base (pre-relief) points of the skin vertices
+    // vertex ranges of the mouth interior pieces
+    int tongue_first_ = 0, tongue_count_ = 0, tongue_rings_ = 0, tongue_segments_ = 0;
+    int upper_teeth_first_ = 0, lower_teeth_first_ = 0, teeth_sections_ = 0;
+};
+
+void Generator::make_columns() {
+    int front = scaled(p_.front_columns, scale_, 8);
+    if (front % 2) ++front;
+    int back = scaled(p_.back_columns, scale_, 4);
+    if (back % 2) ++back;
+    const double a = p_.front_half_angle_deg * kDeg;
+    theta_.clear();
+    for (int k = 0; k < back / 2; ++k) theta_.push_back(-kPi + (kPi - a) * k / (back / 2));
+    for (int k = 0; k < front; ++k) theta_.push_back(-a + 2 * a * k / front);
+    for (int k = 0; k <= back / 2; ++k) theta_.push_back(a + (kPi - a) * k / (back / 2));
+    ncols_ = static_cast<int>(theta_.size()) - 1;
+    centre_col_ = back / 2 + front / 2;
+    theta_[centre_col_] = 0.0;
+}
+
+void Generator::make_rows() {
+    // Angle of the mouth line at the midline, so one row runs along it.
+    Row eye_level{};
+    const double mouth_dphi = solve_offset(0.0, eye_level, [&](double) { return shape_.mouth_line(0.0); });
+    mouth_angle_ = mouth_dphi;
+
+    // Downward sweep from eye level, with a row forced at the mouth angle
+    // inside the first segment.
+    std::vector<Row> down;
+    const auto& lk = p_.lower_rows;
+    for (std::size_t k = 0; k + 1 < lk.size(); ++k) {
+        const int n = scaled(lk[k].rows, scale_, 2);
+        if (k == 0) {
+            const double total = lk[1].angle_front_deg - lk[0].angle_front_deg;  // negative
+            const double m = mouth_angle_ / kDeg;
+            if (!(total < m && m < 0) || lk[0].angle_front_deg != 0.0 || lk[0].origin_y != 0.0 ||
+                lk[1].origin_y != 0.0 || lk[1].origin_z_front != lk[0].origin_z_front)
+                fail<InputError>("expression: {}: lower_rows must start at eye level (origin_y 0, angle 0) and its "
+                                 "first segment, from the head centre, must reach below the mouth ({:.1f} deg)",
+                                 p_.file, m);
+            const int n1 = std::max(2, static_cast<int>(std::lround(n * m / total)));
+            const int n2 = std::max(2, n - n1);
+            const detail::RowKey mk = lerp_key(lk[0], lk[1], m / total);
+            sweep(lk[0], mk, n1, down);
+            mouth_row_down_ = static_cast<int>(down.size()) - 1;
+            sweep(mk, lk[1], n2, down);
+        } else {
+            sweep(lk[k], lk[k + 1], n, down);
+        }
+    }
+    std::vector<Row> up;
+    const auto& uk = p_.upper_rows;
+    for (std::size_t k = 0; k + 1 < uk.size(); ++k) sweep(uk[k], uk[k + 1], scaled(uk[k].rows, scale_, 2), up);
+
+    rows_.assign(down.rbegin(), down.rend());
+    eye_row_ = static_cast<int>(rows_.size());
+    mouth_row_ = eye_row_ - 1 - mouth_row_down_;
+    rows_.push_back(to_row(lk[0]));
+    rows_.insert(rows_.end(), up.begin(), up.end());
+}
+
+void Generator::compute_warps() {
+    const int n = ncols_ + 1;
+    eye_up_.assign(n, 0.0);
+    eye_lo_.assign(n, 0.0);
+    mouth_dphi_.assign(n, 0.0);
+    eye_lower_copy_.assign(n, -1);
+    mouth_lower_copy_.assign(n, -1);
+    const Row& r0 = rows_[eye_row_];
+    const Row& rm = rows_[mouth_row_];
+    auto mirror = [&](int i) { return 2 * centre_col_ - i; };
+
+    // Eye corners: the columns whose corner-height vertex is nearest the
+    // designed corners; the opening is then fitted between those columns.
+    auto corner_x = [&](int i, double y) {
+        const double d = solve_offset(theta_[i], r0, [&](double) { return y; });
+        return base_point(theta_[i], r0, d).x;
+    };
+    auto nearest_col = [&](double x, double y, const Row& row, bool eye) {
+        int best = centre_col_;
+        double best_d = std::numeric_limits<double>::max();
+        for (int i = centre_col_; i <= ncols_ && theta_[i] < p_.front_half_angle_deg * kDeg; ++i) {
+            const double xi = eye ? corner_x(i, y)
+                                  : base_point(theta_[i], row, solve_offset(theta_[i], row, [&](double) { return y; })).x;
+            if (std::abs(xi - x) < best_d) {
+                best_d = std::abs(xi - x);
+                best = i;
+            }
+        }
+        return best;
+    };
+    eye_in_col_ = nearest_col(p_.inner_corner[0], p_.inner_corner[1], r0, true);
+    eye_out_col_ = nearest_col(p_.outer_corner[0], p_.outer_corner[1], r0, true);
+    if (eye_out_col_ - eye_in_col_ < 4)
+        fail<InputError>("expression: {}: the eye opening spans {} grid columns; raise resolution.front_columns",
+                         p_.file, eye_out_col_ - eye_in_col_);
+    shape_.set_eye_corners(corner_x(eye_in_col_, p_.inner_corner[1]), corner_x(eye_out_col_, p_.outer_corner[1]));
+
+    const double corner_in = solve_offset(theta_[eye_in_col_], r0, [&](double) { return shape_.eye.y_in; });
+    const double corner_out = solve_offset(theta_[eye_out_col_], r0, [&](double) { return shape_.eye.y_out; });
+    const double x_in = shape_.eye.x_in, x_out = shape_.eye.x_out;
+    constexpr double kEyeFade = 8.0;  // mm beyond a corner over which the corner's offset fades
+    for (int i = centre_col_; i <= ncols_ && theta_[i] < kPi * 0.5; ++i) {
+        double up, lo;
+        if (i == eye_in_col_) {
+            up = lo = corner_in;
+        } else if (i == eye_out_col_) {
+            up = lo = corner_out;
+        } else if (i > eye_in_col_ && i < eye_out_col_) {
+            up = solve_offset(theta_[i], r0, [&](double x) { return shape_.eye.upper(std::abs(x)); });
+            lo = solve_offset(theta_[i], r0, [&](double x) { return shape_.eye.lower(std::abs(x)); });
+        } else {
+            const double x = base_point(theta_[i], r0, 0.0).x;
+            const double to_in = std::abs(x - x_in), to_out = std::abs(x - x_out);
+            up = lo = to_in < to_out ? corner_in * warp_falloff(to_in, kEyeFade)
+                                     : corner_out * warp_falloff(to_out, kEyeFade);
+        }
+        eye_up_[i] = eye_up_[mirror(i)] = up;
+        eye_lo_[i] = eye_lo_[mirror(i)] = lo;
+    }
+
+    // Mouth corners and the closed mouth line between them.
+    mouth_corner_col_ = nearest_col(p_.mouth_half_width, shape_.mouth_line(p_.mouth_half_width), rm, false);
+    if (mouth_corner_col_ - centre_col_ < 4)
+        fail<InputError>("expression: {}: the mouth spans too few grid columns; raise resolution.front_columns",
+                         p_.file);
+    {
+        const double d = solve_offset(theta_[mouth_corner_col_], rm,
+                                      [&](double) { return shape_.mouth_line(p_.mouth_half_width); });
+        shape_.set_mouth_half_width(base_point(theta_[mouth_corner_col_], rm, d).x);
+    }
+    const double hw = shape_.mouth_half_width();
+    const double corner_d = solve_offset(theta_[mouth_corner_col_], rm, [&](double) { return shape_.mouth_line(hw); });
+    constexpr double kMouthFade = 14.0;
+    for (int i = centre_col_; i <= ncols_ && theta_[i] < kPi * 0.5; ++i) {
+        double d;
+        if (i <= mouth_corner_col_) {
+            d = i == mouth_corner_col_ ? corner_d
+                                       : solve_offset(theta_[i], rm, [&](double x) { return shape_.mouth_line(x); });
+        } else {
+            const double x = base_point(theta_[i], rm, 0.0).x;
+            d = corner_d * warp_falloff(std::abs(x - hw), kMouthFade);
+        }
+        mouth_dphi_[i] = mouth_dphi_[mirror(i)] = d;
+    }
+}
+
+void Generator::build_skin(Face& face) {
+    const int nrows = static_cast<int>(rows_.size());
+    const double eye_reach = p_.lid_warp_reach / 90.0;
+    const double mouth_reach = p_.mouth_warp_reach / 100.0;
+    const Row& r0 = rows_[eye_row_];
+    const Row& rm = rows_[mouth_row_];
+    auto offset = [&](int i, int j, bool lower_copy) {
+        const Row& r = rows_[j];
+        if (!r.same_origin(r0)) return 0.0;
+        const double th = theta_[i];
+        const double a = r.angle(th) - r0.angle(th);
+        double d = 0.0;
+        if (j == eye_row_) d += lower_copy ? eye_lo_[i] : eye_up_[i];
+        else if (j > eye_row_) d += eye_up_[i] * warp_falloff(a, eye_reach);
+        else d += eye_lo_[i] * warp_falloff(-a, eye_reach);
+        d += mouth_dphi_[i] * warp_falloff(std::abs(r.angle(th) - rm.angle(th)), mouth_reach);
+        return d;
+    };
+    auto v_of = [&](int j) { return detail::kSkinV0 + (0.995 - detail::kSkinV0) * j / (nrows - 1); };
+
+    for (int j = 0; j < nrows; ++j) {
+        for (int i = 0; i <= ncols_; ++i) {
+            const V3 b = base_point(theta_[i], rows_[j], offset(i, j, false));
+            base_.push_back(b);
+            add_vertex(face, shape_.displace(b), static_cast<double>(i) / ncols_, v_of(j), VertexPart::Skin);
+        }
+    }
+    auto mirror = [&](int i) { return 2 * centre_col_ - i; };
+    for (int i = eye_in_col_ + 1; i < eye_out_col_; ++i) {
+        for (int c : {i, mirror(i)}) {
+            const V3 b = base_point(theta_[c], rows_[eye_row_], offset(c, eye_row_, true));
+            base_.push_back(b);
+            eye_lower_copy_[c] = add_vertex(face, shape_.displace(b), static_cast<double>(c) / ncols_, v_of(eye_row_),
+                                            VertexPart::Skin)
+                                     .idx();
+        }
+    }
+    for (int i = mirror(mouth_corner_col_) + 1; i < mouth_corner_col_; ++i) {
+        const V3 b = base_[grid(i, mouth_row_)];
+        base_.push_back(b);
+        mouth_lower_copy_[i] =
+            add_vertex(face, shape_.displace(b), static_cast<double>(i) / ncols_, v_of(mouth_row_), VertexPart::Skin).idx();
+    }
+    {
+        const V3 o = rows_.back().origin(0.0);
+        const V3 b = o + V3{0, 1, 0} * shape_.cast(o, {0, 1, 0});
+        base_.push_back(b);
+        pole_ = add_vertex(face, shape_.displace(b), 0.5, 0.999, VertexPart::Skin).idx();
+    }
+
+    // The band just below a slit row takes the lower copies.
+    auto at = [&](int i, int j, bool below_slit) {
+        if (below_slit && j == eye_row_ && eye_lower_copy_[i] >= 0) return eye_lower_copy_[i];
+        if (below_slit && j == mouth_row_ && mouth_lower_copy_[i] >= 0) return mouth_lower_copy_[i];
+        return grid(i, j);
+    };
+    for (int j = 0; j + 1 < nrows; ++j) {
+        for (int i = 0; i < ncols_; ++i) {
+            const int a = grid(i, j), b = grid(i + 1, j);
+            const int c = at(i + 1, j + 1, true), d = at(i, j + 1, true);
+            // Diagonals mirror across the midline so symmetric FAPs deform
+            // both halves alike.
+            if (i >= centre_col_) {
+                add_triangle(face, a, b, c);
+                add_triangle(face, a, c, d);
+            } else {
+                add_triangle(face, a, b, d);
+                add_triangle(face, b, c, d);
+            }
+        }
+    }
+    for (int i = 0; i < ncols_; ++i) add_triangle(face, grid(i, nrows - 1), grid(i + 1, nrows - 1), pole_);
+}
+
+void Generator::build_eyeball(Face& face, int side) {
+    const double sx = side == 0 ? 1.0 : -1.0;
+    const V3 c{p_.eye_centre[0] * sx, p_.eye_centre[1], p_.eye_centre[2]};
+    const double R = p_.eye_radius;
+    const int rings = p_.eyeball_rings, segs = p_.eyeball_segments;
+    const double iris = std::asin(p_.iris_radius / R);
+    // A third of the rings cover the iris so pupil dilation has vertices to move.
+    std::vector<double> alpha;
+    const int front_rings = rings / 3;
+    for (int k = 1; k <= front_rings; ++k) alpha.push_back(iris * 1.15 * k / front_rings);
+    for (int k = 1; k < rings - front_rings; ++k)
+        alpha.push_back(detail::mix(iris * 1.15, kPi * 0.985, static_cast<double>(k) / (rings - front_rings - 1)));
+
+    Eyeball eb;
+    eb.centre = {c.x, c.y, c.z};
+    eb.radius = R;
+    eb.iris_angle = iris;
+    eb.pupil_angle = std::asin(p_.pupil_radius / R);
+    eb.vertices.first = face.vertex_count();
+    const VertexPart part = side == 0 ? VertexPart::EyeballLeft : VertexPart::EyeballRight;
+    auto uv = [&](double a, double b, double& u, double& v) {
+        const double r = 0.48 * a / kPi;
+        u = detail::tile_u0(detail::Tile::Eye) + detail::kTile * (0.5 + r * std::cos(b));
+        v = detail::kTile * (0.5 + r * std::sin(b));
+    };
+    const int front = add_vertex(face, c + V3{0, 0, R}, detail::tile_u0(detail::Tile::Eye) + 0.5 * detail::kTile,
+                                 0.5 * detail::kTile, part)
+                          .idx();
+    const int first_ring = face.vertex_count();
+    for (double a : alpha) {
+        for (int s = 0; s < segs; ++s) {
+            const double b = 2 * kPi * s / segs;
+            double u, v;
+            uv(a, b, u, v);
+            add_vertex(face, c + V3{std::sin(a) * std::cos(b), std::sin(a) * std::sin(b), std::cos(a)} * R, u, v, part);
+        }
+    }
+    double bu, bv;
+    uv(kPi, 0, bu, bv);
+    const int back = add_vertex(face, c + V3{0, 0, -R}, bu, bv, part).idx();
+    eb.vertices.count = face.vertex_count() - eb.vertices.first;
+    auto ring = [&](int k, int s) { return first_ring + k * segs + (s % segs); };
+    auto out = [&](int a) {
+        const auto q = face.mesh.point(TriMesh::VertexHandle(a));
+        return V3{q[0] - c.x, q[1] - c.y, q[2] - c.z};
+    };
+    const int nr = static_cast<int>(alpha.size());
+    for (int s = 0; s < segs; ++s) add_oriented(face, front, ring(0, s), ring(0, s + 1), out(ring(0, s)));
+    for (int k = 0; k + 1 < nr; ++k)
+        for (int s = 0; s < segs; ++s) {
+            add_oriented(face, ring(k, s), ring(k + 1, s), ring(k + 1, s + 1), out(ring(k + 1, s)));
+            add_oriented(face, ring(k, s), ring(k + 1, s + 1), ring(k, s + 1), out(ring(k, s + 1)));
+        }
+    for (int s = 0; s < segs; ++s) add_oriented(face, back, ring(nr - 1, s + 1), ring(nr - 1, s), out(ring(nr - 1, s)));
+
+    // Eyelid margins from the inner to the outer corner.
+    auto col = [&](int i) { return side == 0 ? i : 2 * centre_col_ - i; };
+    for (int i = eye_in_col_; i <= eye_out_col_; ++i) {
+        const int ci = col(i);
+        eb.upper_margin.push_back(grid(ci, eye_row_));
+        eb.lower_margin.push_back(eye_lower_copy_[ci] >= 0 ? eye_lower_copy_[ci] : grid(ci, eye_row_));
+    }
+    face.eyeballs.push_back(std::move(eb));
+}
+
+void Generator::build_mouth_interior(Face& face) {
+    using detail::Tile;
+    // Cavity: the back half of an ellipsoid, open towards the lips, seen from inside.
+    {
+        const V3 cc{p_.cavity_centre[0], p_.cavity_centre[1], p_.cavity_centre[2]};
+        const V3 r{p_.cavity_radii[0], p_.cavity_radii[1], p_.cavity_radii[2]};
+        const int rings = 10, segs = 36;
+        auto part_of = [&](double y) { return y >= cc.y ? VertexPart::MouthUpper : VertexPart::MouthLower; };
+        auto uv = [&](double g, double s, double& u, double& v) {
+            const double rr = 0.48 * g / (0.5 * kPi);
+            u = detail::tile_u0(Tile::Cavity) + detail::kTile * (0.5 + rr * std::cos(s));
+            v = detail::kTile * (0.5 + rr * std::sin(s));
+        };
+        double u, v;
+        uv(0, 0, u, v);
+        const int back = add_vertex(face, cc + V3{0, 0, -r.z}, u, v, part_of(cc.y)).idx();
+        const int first = face.vertex_count();
+        for (int k = 1; k <= rings; ++k) {
+            const double g = 0.5 * kPi * k / rings;
+            for (int s = 0; s < segs; ++s) {
+                const double a = 2 * kPi * s / segs;
+                const V3 q = cc + V3{r.x * std::sin(g) * std::cos(a), r.y * std::sin(g) * std::sin(a), -r.z * std::cos(g)};
+                uv(g, a, u, v);
+                add_vertex(face, q, u, v, part_of(q.y));
+            }
+        }
+        auto ring = [&](int k, int s) { return first + k * segs + (s % segs); };
+        auto inward = [&](int a) {
+            const auto q = face.mesh.point(TriMesh::VertexHandle(a));
+            return V3{cc.x - q[0], cc.y - q[1], cc.z - q[2]};
+        };
+        for (int s = 0; s < segs; ++s) add_oriented(face, back, ring(0, s), ring(0, s + 1), inward(ring(0, s)));
+        for (int k = 0; k + 1 < rings; ++k)
+            for (int s = 0; s < segs; ++s) {
+                add_oriented(face, ring(k, s), ring(k + 1, s), ring(k + 1, s + 1), inward(ring(k + 1, s)));
+                add_oriented(face, ring(k, s), ring(k + 1, s + 1), ring(k, s + 1), inward(ring(k, s + 1)));
+            }
+    }
+    // Teeth: two arches swept along a curve behind the lips, a closed
+    // four-sided cross-section each.
+    const auto stomion = face.mesh.point(TriMesh::VertexHandle(grid(centre_col_, mouth_row_)));
+    const double z_upper = stomion[2] - p_.teeth_gap;
+    const double thickness = 2.4;
+    const int sections = 28;
+    teeth_sections_ = sections + 1;
+    auto arch = [&](bool upper) {
+        const double y_edge = upper ? p_.mouth_y - 1.0 : p_.mouth_y + 1.2;
+        const double y_root = upper ? y_edge + p_.teeth_height : y_edge - p_.teeth_height * 0.9;
+        const double z0 = upper ? z_upper : z_upper - thickness - 0.4;
+        const double W = upper ? p_.teeth_half_width : p_.teeth_half_width - 1.5;
+        const VertexPart part = upper ? VertexPart::MouthUpper : VertexPart::MouthLower;
+        const int first = face.vertex_count();
+        for (int k = 0; k <= sections; ++k) {
+            const double tau = (-0.5 + static_cast<double>(k) / sections) * kPi * 0.92;
+            const V3 front{W * std::sin(tau), 0.0, z0 - p_.teeth_depth * (1.0 - std::cos(tau))};
+            // Inward normal of the arch, an ellipse centred at z0 - depth.
+            const double zc = z0 - p_.teeth_depth;
+            const V3 in = detail::normalised(
+                V3{-front.x / (W * W), 0.0, -(front.z - zc) / (p_.teeth_depth * p_.teeth_depth)});
+            const V3 sec[4] = {front + V3{0, y_root, 0}, front + V3{0, y_edge, 0},
+                               front + in * thickness + V3{0, y_edge, 0}, front + in * thickness + V3{0, y_root, 0}};
+            for (int c = 0; c < 4; ++c) {
+                const double u = detail::tile_u0(Tile::Teeth) + detail::kTile * (0.02 + 0.96 * k / sections);
+                const double v = detail::kTile * ((upper ? 0.5 : 0.0) + 0.02 + 0.46 * c / 3.0);
+                add_vertex(face, sec[c], u, v, part);
+            }
+        }
+        for (int k = 0; k < sections; ++k) {
+            for (int c = 0; c < 4; ++c) {
+                const int c2 = (c + 1) % 4;
+                const int a = first + 4 * k + c, b = first + 4 * (k + 1) + c;
+                const int d = first + 4 * k + c2, e = first + 4 * (k + 1) + c2;
+                V3 centre{}, mid{};
+                for (int q = 0; q < 4; ++q) {
+                    const auto pq = face.mesh.point(TriMesh::VertexHandle(first + 4 * k + q));
+                    centre = centre + V3{pq[0], pq[1], pq[2]} * 0.25;
+                }
+                const auto pa = face.mesh.point(TriMesh::VertexHandle(a));
+                const auto pd = face.mesh.point(TriMesh::VertexHandle(d));
+                mid = V3{0.5 * (pa[0] + pd[0]), 0.5 * (pa[1] + pd[1]), 0.5 * (pa[2] + pd[2])};
+                add_oriented(face, a, b, e, mid - centre);
+                add_oriented(face, a, e, d, mid - centre);
+            }
+        }
+        return first;
+    };
+    upper_teeth_first_ = arch(true);
+    lower_teeth_first_ = arch(false);
+
+    // Tongue: an ellipsoid resting on the cavity floor, tip (+z pole) forward.
+    {
+        const V3 tc{p_.tongue_centre[0], p_.tongue_centre[1], p_.tongue_centre[2]};
+        const V3 r{p_.tongue_radii[0], p_.tongue_radii[1], p_.tongue_radii[2]};
+        tongue_rings_ = 10;
+        tongue_segments_ = 16;
+        auto uv = [&](double a, double b, double& u, double& v) {
+            const double rr = 0.48 * a / kPi;
+            u = detail::tile_u0(Tile::Tongue) + detail::kTile * (0.5 + rr * std::cos(b));
+            v = detail::kTile * (0.5 + rr * std::sin(b));
+        };
+        tongue_first_ = face.vertex_count();
+        double u, v;
+        uv(0, 0, u, v);
+        const int tip = add_vertex(face, tc + V3{0, 0, r.z}, u, v, VertexPart::Tongue).idx();
+        const int first = face.vertex_count();
+        for (int k = 1; k < tongue_rings_; ++k) {
+            const double a = kPi * k / tongue_rings_;
+            for (int s = 0; s < tongue_segments_; ++s) {
+                const double b = 2 * kPi * s / tongue_segments_;
+                uv(a, b, u, v);
+                add_vertex(face, tc + V3{r.x * std::sin(a) * std::cos(b), r.y * std::sin(a) * std::sin(b), r.z * std::cos(a)},
+                           u, v, VertexPart::Tongue);
+            }
+        }
+        uv(kPi, 0, u, v);
+        const int root = add_vertex(face, tc + V3{0, 0, -r.z}, u, v, VertexPart::Tongue).idx();
+        tongue_count_ = face.vertex_count() - tongue_first_;
+        const int segs = tongue_segments_, nr = tongue_rings_ - 1;
+        auto ring = [&](int k, int s) { return first + k * segs + (s % segs); };
+        auto out = [&](int a) {
+            const auto q = face.mesh.point(TriMesh::VertexHandle(a));
+            return V3{q[0] - tc.x, q[1] - tc.y, q[2] - tc.z};
+        };
+        for (int s = 0; s < segs; ++s) add_oriented(face, tip, ring(0, s), ring(0, s + 1), out(ring(0, s)));
+        for (int k = 0; k + 1 < nr; ++k)
+            for (int s = 0; s < segs; ++s) {
+                add_oriented(face, ring(k, s), ring(k + 1, s), ring(k + 1, s + 1), out(ring(k + 1, s)));
+                add_oriented(face, ring(k, s), ring(k + 1, s + 1), ring(k, s + 1), out(ring(k, s + 1)));
+            }
+        for (int s = 0; s < segs; ++s) add_oriented(face, root, ring(nr - 1, s + 1), ring(nr - 1, s), out(ring(nr - 1, s)));
+    }
+}
+
+void Generator::place_feature_points(Face& face) {
+    std::array<bool, 84> placed{};
+    auto set_vertex = [&](const char* id, int v) {
+        const int k = fap::feature_point_index(id);
+        const auto q = face.mesh.point(TriMesh::VertexHandle(v));
+        face.feature_points[k] = FeaturePointLocation{true, v, {q[0], q[1], q[2]}};
+        placed[k] = true;
+    };
+    auto set_free = [&](const char* id, V3 p) {
+        const int k = fap::feature_point_index(id);
+        face.feature_points[k] = FeaturePointLocation{true, -1, {p.x, p.y, p.z}};
+        placed[k] = true;
+    };
+    auto mirror = [&](int i) { return 2 * centre_col_ - i; };
+    auto px = [&](int v) { return static_cast<double>(face.mesh.point(TriMesh::VertexHandle(v))[0]); };
+    auto py = [&](int v) { return static_cast<double>(face.mesh.point(TriMesh::VertexHandle(v))[1]); };
+    // Front column whose vertex on row j is nearest x (left side, x > 0).
+    auto col_near = [&](double x, int j) {
+        int best = centre_col_;
+        for (int i = centre_col_; i <= ncols_ && theta_[i] < kPi * 0.5; ++i)
+            if (std::abs(px(grid(i, j)) - x) < std::abs(px(grid(best, j)) - x)) best = i;
+        return best;
+    };
+    // Vertex of column i between rows j0 and j1 nearest height y.
+    auto row_near = [&](int i, int j0, int j1, double y) {
+        int best = grid(i, j0);
+        for (int j = std::min(j0, j1); j <= std::max(j0, j1); ++j)
+            if (std::abs(py(grid(i, j)) - y) < std::abs(py(best) - y)) best = grid(i, j);
+        return best;
+    };
+
+    // Inner lip contour: the mouth slit.
+    const int cm = mouth_corner_col_;
+    set_vertex("2.2", grid(centre_col_, mouth_row_));
+    set_vertex("2.3", mouth_lower_copy_[centre_col_]);
+    set_vertex("2.4", grid(cm, mouth_row_));
+    set_vertex("2.5", grid(mirror(cm), mouth_row_));
+    const double hw = shape_.mouth_half_width();
+    const int half = std::min(col_near(hw * 0.5, mouth_row_), cm - 1);
+    set_vertex("2.6", grid(half, mouth_row_));
+    set_vertex("2.7", grid(mirror(half), mouth_row_));
+    set_vertex("2.8", mouth_lower_copy_[half]);
+    set_vertex("2.9", mouth_lower_copy_[mirror(half)]);
+    // Outer lip contour: the vermilion borders.
+    const int up_rows = mouth_row_ + 20, lo_rows = std::max(0, mouth_row_ - 20);
+    set_vertex("8.1", row_near(centre_col_, mouth_row_ + 1, up_rows, shape_.upper_border(0)));
+    set_vertex("8.2", row_near(centre_col_, lo_rows, mouth_row_ - 1, shape_.lower_border(0)));
+    const int oc = col_near(hw + p_.outer_corner_offset, mouth_row_);
+    set_vertex("8.3", grid(oc, mouth_row_));
+    set_vertex("8.4", grid(mirror(oc), mouth_row_));
+    set_vertex("8.5", row_near(half, mouth_row_ + 1, up_rows, shape_.upper_border(px(grid(half, mouth_row_)))));
+    set_vertex("8.6", row_near(mirror(half), mouth_row_ + 1, up_rows, shape_.upper_border(px(grid(half, mouth_row_)))));
+    set_vertex("8.7", row_near(half, lo_rows, mouth_row_ - 1, shape_.lower_border(px(grid(half, mouth_row_)))));
+    set_vertex("8.8", row_near(mirror(half), lo_rows, mouth_row_ - 1, shape_.lower_border(px(grid(half, mouth_row_)))));
+    {
+        int peak = centre_col_;
+        for (int i = centre_col_; i < cm; ++i)
+            if (shape_.upper_border(px(grid(i, mouth_row_))) > shape_.upper_border(px(grid(peak, mouth_row_)))) peak = i;
+        const double y = shape_.upper_border(px(grid(peak, mouth_row_)));
+        set_vertex("8.10", row_near(peak, mouth_row_ + 1, up_rows, y));
+        set_vertex("8.9", row_near(mirror(peak), mouth_row_ + 1, up_rows, y));
+    }
+    // Eyes.
+    const int ce = std::clamp(col_near(p_.eye_centre[0], eye_row_), eye_in_col_ + 1, eye_out_col_ - 1);
+    for (int side = 0; side < 2; ++side) {
+        const int c = side == 0 ? ce : mirror(ce);
+        const bool left = side == 0;
+        const double x = std::abs(px(grid(c, eye_row_)));
+        set_vertex(left ? "3.1" : "3.2", grid(c, eye_row_));
+        set_vertex(left ? "3.3" : "3.4", eye_lower_copy_[c]);
+        set_vertex(left ? "3.13" : "3.14", row_near(c, eye_row_ + 1, eye_row_ + 15, shape_.eye.upper(x) + 4.5));
+        set_vertex(left ? "3.9" : "3.10", row_near(c, eye_row_ - 15, eye_row_ - 1, shape_.eye.lower(x) - 3.5));
+        const int in = left ? eye_in_col_ : mirror(eye_in_col_), out = left ? eye_out_col_ : mirror(eye_out_col_);
+        set_vertex(left ? "3.11" : "3.8", grid(in, eye_row_));
+        set_vertex(left ? "3.7" : "3.12", grid(out, eye_row_));
+        set_vertex(left ? "3.5" : "3.6", face.eyeballs[side].vertices.first);
+    }
+    // Skin points found by target position.
+    const int skin_end = static_cast<int>(base_.size());
+    auto nearest_front = [&](double x, double y) {
+        int best = -1;
+        double best_d = std::numeric_limits<double>::max();
+        for (int v = 0; v < skin_end; ++v) {
+            const auto n = face.mesh.normal(TriMesh::VertexHandle(v));
+            if (n[2] < 0.25) continue;
+            const double d = std::hypot(px(v) - x, py(v) - y);
+            if (d < best_d) {
+                best_d = d;
+                best = v;
+            }
+        }
+        return best;
+    };
+    auto nearest_3d = [&](V3 t) {
+        int best = 0;
+        double best_d = std::numeric_limits<double>::max();
+        for (int v = 0; v < skin_end; ++v) {
+            const auto q = face.mesh.point(TriMesh::VertexHandle(v));
+            const double d = length(V3{q[0] - t.x, q[1] - t.y, q[2] - t.z});
+            if (d < best_d) {
+                best_d = d;
+                best = v;
+            }
+        }
+        return best;
+    };
+    // Brows (4.1 inner, 4.3 uppermost, 4.5 outer; right side mirrored).
+    const char* brow_ids[3][2] = {{"4.1", "4.2"}, {"4.3", "4.4"}, {"4.5", "4.6"}};
+    for (int k = 0; k < 3; ++k) {
+        set_vertex(brow_ids[k][0], nearest_front(p_.brow_points[k][0], p_.brow_points[k][1]));
+        set_vertex(brow_ids[k][1], nearest_front(-p_.brow_points[k][0], p_.brow_points[k][1]));
+    }
+    // Nose tip: the most forward skin point near the midline.
+    {
+        int best = -1;
+        for (int v = 0; v < skin_end; ++v) {
+            if (std::abs(px(v)) > 2.0 || py(v) > 0 || py(v) < p_.mouth_y) continue;
+            if (best < 0 || face.mesh.point(TriMesh::VertexHandle(v))[2] > face.mesh.point(TriMesh::VertexHandle(best))[2])
+                best = v;
+        }
+        set_vertex("9.3", best);
+    }
+    // Ears: top, back, lobe and the contact points, from the ear's ellipse.
+    {
+        const double ye = p_.ear_centre_yz[0], ze = p_.ear_centre_yz[1];
+        const double ry = p_.ear_radii_yz[0], rz = p_.ear_radii_yz[1];
+        const double far = 200.0, near = 60.0;
+        struct EarPoint {
+            const char* left;
+            const char* right;
+            double x, y, z;
+        } ears[] = {{"10.1", "10.2", far, ye + 0.9 * ry, ze},        {"10.3", "10.4", far, ye, ze - 0.9 * rz},
+                    {"10.5", "10.6", far, ye - 0.9 * ry, ze},        {"10.7", "10.8", near, ye - 0.55 * ry, ze + 0.8 * rz},
+                    {"10.9", "10.10", near, ye + 0.55 * ry, ze + 0.8 * rz}};
+        for (const EarPoint& e : ears) {
+            set_vertex(e.left, nearest_3d({e.x, e.y, e.z}));
+            set_vertex(e.right, nearest_3d({-e.x, e.y, e.z}));
+        }
+    }
+    // Mouth interior.
+    {
+        const int segs = tongue_segments_;
+        const int mid_ring = tongue_rings_ / 2 - 1;  // ring at pi/2
+        set_vertex("6.1", tongue_first_);
+        set_vertex("6.2", tongue_first_ + 1 + mid_ring * segs + segs / 4);
+        set_vertex("6.3", tongue_first_ + 1 + mid_ring * segs);
+        set_vertex("6.4", tongue_first_ + 1 + mid_ring * segs + segs / 2);
+        const int centre_section = (teeth_sections_ - 1) / 2;
+        set_vertex("9.8", upper_teeth_first_ + 4 * centre_section + 0);
+        set_vertex("9.9", lower_teeth_first_ + 4 * centre_section + 0);
+        set_vertex("9.10", upper_teeth_first_ + 4 * centre_section + 1);
+        set_vertex("9.11", lower_teeth_first_ + 4 * centre_section + 1);
+    }
+    set_vertex("11.4", pole_);
+    {
+        const auto top = face.mesh.point(TriMesh::VertexHandle(pole_));
+        set_free("11.5", {top[0], top[1] + 6.0, top[2]});
+    }
+    set_free("7.1", {p_.head_pivot[0], p_.head_pivot[1], p_.head_pivot[2]});
+
+    for (const auto& [id, target] : p_.feature_targets) {
+        const auto k = fap::find_feature_point(id);
+        if (!k) fail<InputError>("expression: {}: feature_points: \"{}\" is not an MPEG-4 feature point", p_.file, id);
+        if (placed[*k])
+            fail<InputError>("expression: {}: feature_points: \"{}\" is placed by the generator; remove it", p_.file, id);
+        const int v = target.size() == 2 ? nearest_front(target[0], target[1])
+                                         : nearest_3d({target[0], target[1], target[2]});
+        if (v < 0) fail<InputError>("expression: {}: feature_points: no front-facing skin near \"{}\"", p_.file, id);
+        set_vertex(id.c_str(), v);
+    }
+    for (int k = 0; k < 84; ++k)
+        if (!placed[k])
+            fail<InputError>("expression: {}: feature_points: no target for \"{}\"", p_.file,
+                             std::string(fap::feature_points()[k].id));
+}
+
+Face Generator::build(int texture_size) {
+    Face face;
+    face.name = "default";
+    face.mesh.request_vertex_normals();
+    face.mesh.request_vertex_texcoords2D();
+    make_columns();
+    make_rows();
+    compute_warps();
+    build_skin(face);
+    const int skin_count = face.vertex_count();
+    build_eyeball(face, 0);
+    build_eyeball(face, 1);
+    build_mouth_interior(face);
+    if (rejected_faces_ > 0)
+        fail("expression: {}: {} triangles could not be added (the grid folds); check resolution rows", p_.file,
+             rejected_faces_);
+
+    face.mesh.request_face_normals();
+    face.mesh.update_normals();
+    // The seam at the back of the head doubles a column for the texture; give
+    // both copies the same normal so shading does not show it.
+    for (int j = 0; j < static_cast<int>(rows_.size()); ++j) {
+        const TriMesh::VertexHandle a(grid(0, j)), b(grid(ncols_, j));
+        auto n = face.mesh.normal(a) + face.mesh.normal(b);
+        const float l = n.norm();
+        if (l > 0) n /= l;
+        face.mesh.set_normal(a, n);
+        face.mesh.set_normal(b, n);
+    }
+    (void)skin_count;
+
+    place_feature_points(face);
+    face.jaw_pivot = {p_.jaw_pivot[0], p_.jaw_pivot[1], p_.jaw_pivot[2]};
+    face.head_pivot = {p_.head_pivot[0], p_.head_pivot[1], p_.head_pivot[2]};
+    face.texture_box = {p_.texture_box_min[0], p_.texture_box_min[1], p_.texture_box_max[0], p_.texture_box_max[1]};
+    update_fapu(face);
+    face.base_colour = detail::paint_base_colour(shape_, face.mesh, texture_size);
+    return face;
+}
+
+}  // namespace
+
+Face make_default_face(const std::string& params_dir, const DefaultFaceOptions& options) {
+    const FaceParams params = detail::read_face_params(params_dir);
+    if (!(options.resolution_scale > 0.05 && options.resolution_scale <= 4.0))
+        fail<InputError>("expression: resolution_scale must be in (0.05, 4], found {}", options.resolution_scale);
+    if (options.texture_size != 0 && (options.texture_size < 16 || options.texture_size > 8192))
+        fail<InputError>("expression: texture_size must be 0 or in [16, 8192], found {}", options.texture_size);
+    Generator generator(params, options);
+    return generator.build(options.texture_size > 0 ? options.texture_size : params.texture_size);
+}
+
+}  // namespace emoface::expression

@@ -1,0 +1,98 @@
+#include "emoface/expression/face.h"
+
+#include <cmath>
+
+#include "emoface/common/error.h"
+#include "emoface/fap/feature_points.h"
+
+namespace emoface::expression {
+
+const char* part_name(VertexPart part) {
+    switch (part) {
+        case VertexPart::Skin: return "skin";
+        case VertexPart::EyeballLeft: return "eyeball_left";
+        case VertexPart::EyeballRight: return "eyeball_right";
+        case VertexPart::MouthUpper: return "mouth_upper";
+        case VertexPart::MouthLower: return "mouth_lower";
+        case VertexPart::Tongue: return "tongue";
+    }
+    return "?";
+}
+
+const Vec3d& Face::position(int feature_point) const {
+    const FeaturePointLocation& fp = feature_points.at(feature_point);
+    if (!fp.present)
+        fail("expression: face \"{}\" has no feature point {}", name,
+             std::string(fap::feature_points()[feature_point].id));
+    return fp.position;
+}
+
+fap::FeaturePointPositions Face::positions() const {
+    fap::FeaturePointPositions out{};
+    for (int k = 0; k < fap::kFeaturePointCount; ++k)
+        if (feature_points[k].present) out[k] = feature_points[k].position;
+    return out;
+}
+
+void update_fapu(Face& face) {
+    std::string missing;
+    for (const char* id : {"3.1", "3.3", "3.5", "3.6", "9.15", "2.2", "8.3", "8.4"}) {
+        if (!face.has(fap::feature_point_index(id))) missing += missing.empty() ? id : std::string(", ") + id;
+    }
+    if (!missing.empty())
+        fail<InputError>("expression: face \"{}\": cannot compute FAPU without feature points {}", face.name, missing);
+    try {
+        face.fapu = fap::compute_fapu(face.positions());
+    } catch (const InputError& e) {
+        fail<InputError>("expression: face \"{}\": {} (x must point to the face's left, y up, z to the viewer)",
+                         face.name, e.what());
+    }
+}
+
+void validate_face(const Face& face, const std::string& context) {
+    const int n = face.vertex_count();
+    if (n == 0 || face.mesh.n_faces() == 0) fail<InputError>("expression: {}: the mesh has no triangles", context);
+    if (static_cast<int>(face.parts.size()) != n)
+        fail<InputError>("expression: {}: {} vertex parts for {} vertices", context, face.parts.size(), n);
+    for (int k = 0; k < fap::kFeaturePointCount; ++k) {
+        const FeaturePointLocation& fp = face.feature_points[k];
+        if (!fp.present) continue;
+        const auto id = fap::feature_points()[k].id;
+        if (fp.vertex >= n)
+            fail<InputError>("expression: {}: feature point {} names vertex {}, the mesh has {}", context,
+                             std::string(id), fp.vertex, n);
+        for (double c : fp.position)
+            if (!std::isfinite(c))
+                fail<InputError>("expression: {}: feature point {} has a position that is not finite", context,
+                                 std::string(id));
+    }
+    for (const Eyeball& e : face.eyeballs) {
+        if (e.vertices.first < 0 || e.vertices.count <= 0 || e.vertices.end() > n)
+            fail<InputError>("expression: {}: eyeball vertices [{}, {}) outside the mesh's {} vertices", context,
+                             e.vertices.first, e.vertices.end(), n);
+        if (!(e.radius > 0))
+            fail<InputError>("expression: {}: eyeball radius must be positive, found {}", context, e.radius);
+        for (const auto* margin : {&e.upper_margin, &e.lower_margin})
+            for (int v : *margin)
+                if (v < 0 || v >= n)
+                    fail<InputError>("expression: {}: eyelid margin vertex {} outside the mesh's {} vertices", context,
+                                     v, n);
+        if (e.upper_margin.size() != e.lower_margin.size())
+            fail<InputError>("expression: {}: eyelid margins have {} upper and {} lower vertices", context,
+                             e.upper_margin.size(), e.lower_margin.size());
+    }
+    if (face.eyeballs.size() > 2)
+        fail<InputError>("expression: {}: at most 2 eyeballs, found {}", context, face.eyeballs.size());
+    if (!face.base_colour.empty() &&
+        face.base_colour.rgba.size() != static_cast<std::size_t>(face.base_colour.width) * face.base_colour.height * 4)
+        fail<InputError>("expression: {}: base colour image size does not match its pixels", context);
+}
+
+std::vector<std::string> missing_feature_points(const Face& face) {
+    std::vector<std::string> out;
+    for (int k = 0; k < fap::kFeaturePointCount; ++k)
+        if (!face.feature_points[k].present) out.emplace_back(fap::feature_points()[k].id);
+    return out;
+}
+
+}  // namespace emoface::expression

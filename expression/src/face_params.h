@@ -1,0 +1,133 @@
+#pragma once
+// Parameters of the default face generator, read from data/face/face.json.
+// docs/FACE.md explains each block; all lengths are millimetres in the face's
+// frame (x = face's left, y = up, z = towards the viewer; y = 0 at eye level,
+// the head's vertical axis at x = z = 0).
+#include <array>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace emoface::expression::detail {
+
+using Vec2 = std::array<double, 2>;
+using Vec3 = std::array<double, 3>;
+
+struct Ellipsoid {
+    Vec3 centre{};
+    Vec3 radii{};
+};
+
+// A smooth bump added to the face's depth (z) over a frontal ellipse:
+// height * (1 - rho^2)^3, rho the rotated, normalised distance from centre.
+struct Bump {
+    std::string name;
+    Vec2 centre{};
+    Vec2 radius{};
+    double height = 0.0;
+    double angle_deg = 0.0;
+    bool mirror = false;
+};
+
+// A bump along a polyline: height and half-width interpolated along it,
+// cross-section (1 - (d / width)^2)^3, d the distance to the polyline.
+struct Ridge {
+    std::string name;
+    std::vector<Vec2> points;
+    std::vector<double> width;
+    std::vector<double> height;
+    bool mirror = false;
+};
+
+// One key of the ray sweep that lays the grid rows over the head: a row is a
+// fan of rays over azimuth theta from an origin (0, origin_y, z) at elevation
+// angle; z and angle go from their front value (theta = 0) to their back value
+// (theta = 180 deg) with weight (1 + cos theta) / 2, so the rows can wrap
+// under the chin at the front while staying level at the nape. Consecutive
+// keys are joined by `rows` interpolated rows.
+struct RowKey {
+    double origin_y = 0.0;
+    double origin_z_front = 0.0, origin_z_back = 0.0;
+    double angle_front_deg = 0.0, angle_back_deg = 0.0;
+    int rows = 0;
+};
+
+struct FaceParams {
+    std::string file;
+
+    // resolution
+    int front_columns = 0, back_columns = 0;
+    double front_half_angle_deg = 0.0;
+    std::vector<RowKey> upper_rows;  // from eye level (angle 0) up to the crown
+    std::vector<RowKey> lower_rows;  // from eye level down to the neck's cut
+    int eyeball_rings = 0, eyeball_segments = 0;
+    int texture_size = 0;
+
+    // head volume (smooth union)
+    Ellipsoid skull, lower_face, jaw;
+    double neck_centre_z = 0.0;
+    Vec2 neck_radii{};
+    double neck_top_y = 0.0;
+    double blend = 0.0;
+
+    // eyes (left eye; the right one mirrors it)
+    Vec3 eye_centre{};
+    double eye_radius = 0.0, iris_radius = 0.0, pupil_radius = 0.0;
+    Vec2 inner_corner{}, outer_corner{};
+    double upper_lid_height = 0.0, lower_lid_height = 0.0;
+    double upper_lid_peak = 0.5, lower_lid_peak = 0.5;
+    double lid_clearance = 0.0, lid_thickness = 0.0;
+    double lid_blend_inner = 0.0, lid_blend_outer = 0.0;
+    double lid_warp_reach = 0.0;
+
+    // mouth
+    double mouth_y = 0.0, mouth_half_width = 0.0, mouth_corner_rise = 0.0;
+    double upper_lip_height = 0.0, lower_lip_height = 0.0;
+    double cupid_dip = 0.0, cupid_peak_x = 0.0;
+    double upper_lip_protrusion = 0.0, lower_lip_protrusion = 0.0;
+    double lip_crease_depth = 0.0, lip_crease_width = 0.0;
+    double mouth_warp_reach = 0.0;
+    double outer_corner_offset = 0.0;
+
+    // mouth interior
+    Vec3 cavity_centre{};
+    Vec3 cavity_radii{};
+    double teeth_half_width = 0.0, teeth_height = 0.0, teeth_depth = 0.0;
+    double teeth_gap = 0.0;
+    Vec3 tongue_centre{};
+    Vec3 tongue_radii{};
+
+    // relief
+    std::vector<Bump> bumps;
+    std::vector<Ridge> ridges;
+    std::vector<Bump> nostrils;  // dents painted dark
+
+    // ears (left; mirrored)
+    Vec2 ear_centre_yz{};
+    Vec2 ear_radii_yz{};
+    double ear_height = 0.0;
+
+    // pivots
+    Vec3 jaw_pivot{};
+    Vec3 head_pivot{};
+    Vec2 texture_box_min{}, texture_box_max{};
+
+    // feature points placed by target: [x, y] = nearest front-facing skin
+    // vertex in frontal projection; [x, y, z] = nearest skin vertex in 3D.
+    std::map<std::string, std::vector<double>> feature_targets;
+
+    // colours (sRGB 0..255)
+    Vec3 skin{}, lips{}, brows{}, hair{}, iris{}, sclera{}, mouth{}, teeth{}, tongue{};
+    // brows (left): inner, peak, outer points and thickness at each
+    std::array<Vec2, 3> brow_points{};
+    Vec3 brow_thickness{};
+    // hairline: front height at x = 0, temple point (x, y), how far down the
+    // hair reaches at the sides (sideburn) and back
+    double hairline_y = 0.0;
+    Vec2 hairline_temple{};
+    double sideburn_z = 0.0, sideburn_bottom_y = 0.0, hair_back_bottom_y = 0.0;
+};
+
+FaceParams read_face_params(const std::string& params_dir);
+
+}  // namespace emoface::expression::detail

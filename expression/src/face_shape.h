@@ -1,0 +1,98 @@
+#pragma once
+// The default face's shape as functions of position: a smooth union of
+// ellipsoids for the head volume (cast rays against it to place grid
+// vertices), frontal relief (nose, lips, brow ridge, cheeks, ...) added along
+// z, eyelids that lie on the eyeball sphere near the eye opening, and ears
+// added along the side normal. Shared by the mesh generator and the texture
+// painter, which colours from the same curves (lip borders, eyelid margins).
+#include <array>
+#include <cmath>
+
+#include "face_params.h"
+
+namespace emoface::expression::detail {
+
+struct V3 {
+    double x = 0, y = 0, z = 0;
+};
+inline V3 operator+(V3 a, V3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+inline V3 operator-(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline V3 operator*(V3 a, double s) { return {a.x * s, a.y * s, a.z * s}; }
+inline double dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline double length(V3 a) { return std::sqrt(dot(a, a)); }
+inline V3 normalised(V3 a) {
+    const double l = length(a);
+    return l > 0 ? a * (1.0 / l) : a;
+}
+
+inline double clamp01(double t) { return t < 0 ? 0 : (t > 1 ? 1 : t); }
+inline double smoothstep(double e0, double e1, double x) {
+    const double t = clamp01((x - e0) / (e1 - e0));
+    return t * t * (3 - 2 * t);
+}
+inline double mix(double a, double b, double t) { return a + (b - a) * t; }
+
+// The eye opening of the left eye in frontal coordinates (the right eye is
+// its mirror image: use |x|).
+struct EyeOpening {
+    double x_in = 0, y_in = 0, x_out = 0, y_out = 0;
+    double upper_height = 0, lower_height = 0;
+    double upper_peak = 0.5, lower_peak = 0.5;
+
+    double s(double ax) const { return (ax - x_in) / (x_out - x_in); }
+    double slit(double ax) const { return mix(y_in, y_out, clamp01(s(ax))); }
+    double upper(double ax) const;
+    double lower(double ax) const;
+    bool inside_x(double ax) const { return ax > x_in && ax < x_out; }
+};
+
+class FaceShape {
+public:
+    explicit FaceShape(const FaceParams& params);
+
+    const FaceParams& params() const { return p_; }
+
+    // Head volume: negative inside.
+    double field(V3 p) const;
+    V3 field_normal(V3 p) const;
+    // Distance along a unit direction from an inside origin to the head volume's surface.
+    double cast(V3 origin, V3 dir) const;
+
+    // The final skin position for a point on the head volume's surface.
+    V3 displace(V3 base) const;
+
+    // Frontal relief along z at (x, y), without the eyelid blend.
+    double relief(double x, double y) const;
+
+    // The eye opening (left eye; use |x|), set once the corner columns are known.
+    EyeOpening eye;
+    void set_eye_corners(double x_in, double x_out);
+
+    // Mouth curves at x: the line where the lips meet, the vermilion borders.
+    double mouth_line(double x) const;
+    double upper_border(double x) const;
+    double lower_border(double x) const;
+    double mouth_half_width() const { return mouth_half_width_; }
+    void set_mouth_half_width(double hw) { mouth_half_width_ = hw; }
+
+    // z of the eyelid surface at (x, y): on the eyeball sphere grown by
+    // clearance + thickness(distance from the margin).
+    double lid_z(double x, double y, double margin_distance) const;
+    // 0..1: how much the eyelid surface replaces the relief at (x, y), and the
+    // distance from the eye opening.
+    double lid_blend(double x, double y, double* margin_distance) const;
+
+    // Outward displacement of the ear relief at a side point (y, z), left ear.
+    double ear_relief(double y, double z) const;
+
+    // Depth of the nostril dents at (x, y) as a fraction 0..1 (for painting).
+    double nostril_amount(double x, double y) const;
+
+private:
+    double lip_relief(double x, double y) const;
+
+    const FaceParams& p_;
+    double mouth_half_width_ = 0;
+};
+
+}  // namespace emoface::expression::detail

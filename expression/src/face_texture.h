@@ -1,0 +1,24 @@
+#pragma once
+// Paints the default face's base-colour image by rasterising every triangle
+// in texture space and colouring each texel from the neutral 3D position it
+// covers (skin, lips, brows, lashes, hair, nostrils) or from its place in a
+// part's tile (eyeball, mouth cavity, teeth, tongue).
+#include <vector>
+
+#include "emoface/expression/face.h"
+#include "face_shape.h"
+
+namespace emoface::expression::detail {
+
+// Texture atlas: the skin takes v in [kSkinV0, 1]; the bottom strip holds
+// square tiles, each kTile wide, in this order.
+constexpr double kSkinV0 = 0.25;
+constexpr double kTile = 0.25;
+enum class Tile { Eye = 0, Cavity = 1, Teeth = 2, Tongue = 3 };
+inline double tile_u0(Tile t) { return static_cast<int>(t) * kTile; }
+
+// Texels in the bottom strip are coloured by the tile they fall in, the
+// others as skin from the interpolated neutral position.
+Image paint_base_colour(const FaceShape& shape, const TriMesh& mesh, int size);
+
+}  // namespace emoface::expression::detail
