@@ -39,7 +39,7 @@ namespace emoface::fap {
 
 inline constexpr double kHeaderlessFps = 25;
 inline constexpr long long kMaxFapFrames = 1'000'000;  // 11 hours at 25 fps
-inline constexpr long long kMaxFapFileBytes = 1LL << 30;
+inline constexpr long long kMaxFapFileBytes = 256LL << 20;  // real files are KBs
 
 FapStream read_fap_file(const std::string& path);
 // source_name is what messages call the text ("anim.fap").
