@@ -29,6 +29,7 @@ using detail::FaceParams;
 using detail::FaceShape;
 using detail::V3;
 using detail::length;
+constexpr auto length_of = [](V3 v) { return detail::length(v); };
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180.0;
@@ -41,9 +42,6 @@ struct Row {
     static double front_weight(double theta) { return 0.5 * (1.0 + std::cos(theta)); }
     V3 origin(double theta) const { return {0.0, origin_y, detail::mix(z_back, z_front, front_weight(theta))}; }
     double angle(double theta) const { return detail::mix(angle_back, angle_front, front_weight(theta)); }
-    bool same_origin(const Row& r) const {
-        return origin_y == r.origin_y && z_front == r.z_front && z_back == r.z_back;
-    }
 };
 
 V3 ray_dir(double theta, double phi) {
@@ -113,6 +111,7 @@ private:
     }
 
     void make_columns();
+    std::vector<Row> resample(const std::vector<detail::RowKey>& keys) const;
     void make_rows();
     void compute_warps();
     void build_skin(Face& face);
@@ -151,7 +150,7 @@ private:
     int ncols_ = 0;
     int centre_col_ = 0;
     std::vector<Row> rows_;  // bottom (neck) to top (crown)
-    int eye_row_ = 0, mouth_row_ = 0, mouth_row_down_ = 0;
+    int eye_row_ = 0, mouth_row_ = 0, mouth_row_down_ = 0, mouth_key_ = 0;
     double mouth_angle_ = 0;
     // Per column: elevation offsets of the rows above / below each slit.
     std::vector<double> eye_up_, eye_lo_, mouth_dphi_;
@@ -181,39 +180,81 @@ void Generator::make_columns() {
     theta_[centre_col_] = 0.0;
 }
 
-void Generator::make_rows() {
-    // Angle of the mouth line at the midline, so one row runs along it.
-    Row eye_level{};
-    const double mouth_dphi = solve_offset(0.0, eye_level, [&](double) { return shape_.mouth_line(0.0); });
-    mouth_angle_ = mouth_dphi;
-
-    // Downward sweep from eye level, with a row forced at the mouth angle
-    // inside the first segment.
-    std::vector<Row> down;
-    const auto& lk = p_.lower_rows;
-    for (std::size_t k = 0; k + 1 < lk.size(); ++k) {
-        const int n = scaled(lk[k].rows, scale_, 2);
-        if (k == 0) {
-            const double total = lk[1].angle_front_deg - lk[0].angle_front_deg;  // negative
-            const double m = mouth_angle_ / kDeg;
-            if (!(total < m && m < 0) || lk[0].angle_front_deg != 0.0 || lk[0].origin_y != 0.0 ||
-                lk[1].origin_y != 0.0 || lk[1].origin_z_front != lk[0].origin_z_front)
-                fail<InputError>("expression: {}: lower_rows must start at eye level (origin_y 0, angle 0) and its "
-                                 "first segment, from the head centre, must reach below the mouth ({:.1f} deg)",
-                                 p_.file, m);
-            const int n1 = std::max(2, static_cast<int>(std::lround(n * m / total)));
-            const int n2 = std::max(2, n - n1);
-            const detail::RowKey mk = lerp_key(lk[0], lk[1], m / total);
-            sweep(lk[0], mk, n1, down);
-            mouth_row_down_ = static_cast<int>(down.size()) - 1;
-            sweep(mk, lk[1], n2, down);
-        } else {
-            sweep(lk[k], lk[k + 1], n, down);
+// Rows along a key path: the path is sampled finely, and rows are put at
+// even arc length of the front profile (theta = 0), or of the back profile
+// where that moves faster, so no stretch of the face falls between two rows.
+std::vector<Row> Generator::resample(const std::vector<detail::RowKey>& keys) const {
+    constexpr int kFine = 240;
+    std::vector<Row> out;
+    for (std::size_t k = 0; k + 1 < keys.size(); ++k) {
+        const double spacing = (keys[k].spacing > 0 ? keys[k].spacing : p_.row_spacing) / scale_;
+        std::vector<double> length(kFine + 1, 0.0);
+        V3 prev_f{}, prev_b{};
+        for (int s = 0; s <= kFine; ++s) {
+            const Row row = to_row(lerp_key(keys[k], keys[k + 1], static_cast<double>(s) / kFine));
+            const V3 f = shape_.displace(base_point(0.0, row, 0.0));
+            const V3 b = base_point(kPi, row, 0.0);
+            if (s > 0) length[s] = length[s - 1] + std::max(length_of(f - prev_f), 0.5 * length_of(b - prev_b));
+            prev_f = f;
+            prev_b = b;
+        }
+        const int n = std::max(1, static_cast<int>(std::lround(length[kFine] / spacing)));
+        int s = 0;
+        for (int i = 1; i <= n; ++i) {
+            const double target = length[kFine] * i / n;
+            while (s < kFine && length[s + 1] < target) ++s;
+            const double seg = length[std::min(s + 1, kFine)] - length[s];
+            const double frac = seg > 0 ? (target - length[s]) / seg : 0.0;
+            const double t = std::min(1.0, (s + frac) / kFine);
+            out.push_back(to_row(lerp_key(keys[k], keys[k + 1], t)));
         }
     }
-    std::vector<Row> up;
+    return out;
+}
+
+void Generator::make_rows() {
+    const auto& lk = p_.lower_rows;
     const auto& uk = p_.upper_rows;
-    for (std::size_t k = 0; k + 1 < uk.size(); ++k) sweep(uk[k], uk[k + 1], scaled(uk[k].rows, scale_, 2), up);
+    for (const auto* keys : {&lk, &uk}) {
+        const auto& k0 = keys->front();
+        if (k0.origin_y != 0 || k0.origin_z_front != 0 || k0.origin_z_back != 0 || k0.angle_front_deg != 0 ||
+            k0.angle_back_deg != 0)
+            fail<InputError>("expression: {}: upper_rows and lower_rows must start at eye level (origin_y 0, "
+                             "origin_z [0, 0], angle_deg [0, 0])",
+                             p_.file);
+    }
+    // Split the lower path where its front ray meets the mouth line, so one
+    // row runs exactly along the closed lips.
+    std::vector<detail::RowKey> lower = lk;
+    const double mouth_y = shape_.mouth_line(0.0);
+    bool split = false;
+    for (std::size_t k = 0; k + 1 < lower.size() && !split; ++k) {
+        auto front_y = [&](double t) {
+            return base_point(0.0, to_row(lerp_key(lower[k], lower[k + 1], t)), 0.0).y - mouth_y;
+        };
+        if (front_y(1.0) > 0) continue;
+        double lo = 0.0, hi = 1.0;
+        for (int it = 0; it < 50; ++it) {
+            const double mid = 0.5 * (lo + hi);
+            (front_y(mid) > 0 ? lo : hi) = mid;
+        }
+        detail::RowKey mk = lerp_key(lower[k], lower[k + 1], 0.5 * (lo + hi));
+        mk.spacing = lower[k].spacing;
+        lower.insert(lower.begin() + static_cast<long>(k) + 1, mk);
+        mouth_key_ = static_cast<int>(k) + 1;
+        split = true;
+    }
+    if (!split) fail<InputError>("expression: {}: lower_rows never reaches the mouth", p_.file);
+    mouth_angle_ = to_row(lower[mouth_key_]).angle_front;
+
+    // Rows down to the mouth key, to find the mouth row's index.
+    const std::vector<detail::RowKey> to_mouth(lower.begin(), lower.begin() + mouth_key_ + 1);
+    const std::vector<detail::RowKey> from_mouth(lower.begin() + mouth_key_, lower.end());
+    std::vector<Row> down = resample(to_mouth);
+    mouth_row_down_ = static_cast<int>(down.size()) - 1;
+    const std::vector<Row> rest = resample(from_mouth);
+    down.insert(down.end(), rest.begin(), rest.end());
+    const std::vector<Row> up = resample(uk);
 
     rows_.assign(down.rbegin(), down.rend());
     eye_row_ = static_cast<int>(rows_.size());
@@ -310,20 +351,17 @@ void Generator::compute_warps() {
 
 void Generator::build_skin(Face& face) {
     const int nrows = static_cast<int>(rows_.size());
-    const double eye_reach = p_.lid_warp_reach / 90.0;
-    const double mouth_reach = p_.mouth_warp_reach / 100.0;
-    const Row& r0 = rows_[eye_row_];
-    const Row& rm = rows_[mouth_row_];
+    // Warps fade over a number of rows: the slit offsets are angles of at
+    // most a few rows, and the fade must be slower than them (see warp_falloff).
+    const double spacing = p_.row_spacing / scale_;
+    const double eye_reach = p_.lid_warp_reach / spacing;
+    const double mouth_reach = p_.mouth_warp_reach / spacing;
     auto offset = [&](int i, int j, bool lower_copy) {
-        const Row& r = rows_[j];
-        if (!r.same_origin(r0)) return 0.0;
-        const double th = theta_[i];
-        const double a = r.angle(th) - r0.angle(th);
         double d = 0.0;
         if (j == eye_row_) d += lower_copy ? eye_lo_[i] : eye_up_[i];
-        else if (j > eye_row_) d += eye_up_[i] * warp_falloff(a, eye_reach);
-        else d += eye_lo_[i] * warp_falloff(-a, eye_reach);
-        d += mouth_dphi_[i] * warp_falloff(std::abs(r.angle(th) - rm.angle(th)), mouth_reach);
+        else if (j > eye_row_) d += eye_up_[i] * warp_falloff(j - eye_row_, eye_reach);
+        else d += eye_lo_[i] * warp_falloff(eye_row_ - j, eye_reach);
+        d += mouth_dphi_[i] * warp_falloff(std::abs(j - mouth_row_), mouth_reach);
         return d;
     };
     auto v_of = [&](int j) { return detail::kSkinV0 + (0.995 - detail::kSkinV0) * j / (nrows - 1); };

@@ -9,6 +9,7 @@ Ellipsoid read_ellipsoid(JsonReader r) {
     Ellipsoid e;
     e.centre = r.numbers<3>("centre");
     e.radii = r.numbers<3>("radii");
+    e.tilt_deg = r.number("tilt_deg", 0.0);
     r.finish();
     for (double v : e.radii)
         if (!(v > 0.0)) fail<InputError>("expression: {}: ellipsoid radii must be positive", r.file());
@@ -26,10 +27,10 @@ std::vector<RowKey> read_row_keys(JsonReader& r, const std::string& key) {
         rk.origin_z_back = z[1];
         rk.angle_front_deg = a[0];
         rk.angle_back_deg = a[1];
-        rk.rows = k.has("rows") ? k.integer("rows") : 0;
-        if (rk.rows < 0 || rk.rows > 2000)
-            fail<InputError>("expression: {}: \"{}\": rows must be in [0, 2000], found {}", r.file(),
-                             r.where(key), rk.rows);
+        rk.spacing = k.number("spacing", 0.0);
+        if (rk.spacing < 0 || (rk.spacing > 0 && rk.spacing < 0.2))
+            fail<InputError>("expression: {}: \"{}\": spacing must be at least 0.2 mm, found {}", r.file(),
+                             r.where(key), rk.spacing);
         k.finish();
         keys.push_back(rk);
     }
@@ -67,6 +68,9 @@ FaceParams read_face_params(const std::string& params_dir) {
         p.front_columns = r.integer("front_columns");
         p.back_columns = r.integer("back_columns");
         p.front_half_angle_deg = r.number("front_half_angle_deg");
+        p.row_spacing = r.number("row_spacing_mm");
+        if (!(p.row_spacing >= 0.2 && p.row_spacing <= 50))
+            fail<InputError>("expression: {}: row_spacing_mm must be in [0.2, 50]", p.file);
         p.upper_rows = read_row_keys(r, "upper_rows");
         p.lower_rows = read_row_keys(r, "lower_rows");
         p.eyeball_rings = r.integer("eyeball_rings");
@@ -89,6 +93,7 @@ FaceParams read_face_params(const std::string& params_dir) {
         p.neck_centre_z = neck.number("centre_z");
         p.neck_radii = neck.numbers<2>("radii");
         p.neck_top_y = neck.number("top_y");
+        p.neck_blend = neck.number("blend");
         neck.finish();
         p.blend = r.number("blend");
         r.finish();

@@ -13,9 +13,12 @@ namespace emoface::expression::detail {
 using Vec2 = std::array<double, 2>;
 using Vec3 = std::array<double, 3>;
 
+// An ellipsoid pitched by tilt_deg about the x axis (positive: its front end
+// goes down), as the mandible runs from the chin up to the jaw angle.
 struct Ellipsoid {
     Vec3 centre{};
     Vec3 radii{};
+    double tilt_deg = 0.0;
 };
 
 // A smooth bump added to the face's depth (z) over a frontal ellipse:
@@ -43,13 +46,14 @@ struct Ridge {
 // fan of rays over azimuth theta from an origin (0, origin_y, z) at elevation
 // angle; z and angle go from their front value (theta = 0) to their back value
 // (theta = 180 deg) with weight (1 + cos theta) / 2, so the rows can wrap
-// under the chin at the front while staying level at the nape. Consecutive
-// keys are joined by `rows` interpolated rows.
+// under the chin at the front while staying level at the nape. Between keys
+// the sweep is linear; rows are placed along it every `spacing` mm (of the
+// front profile, or of the back one where that moves faster) up to the next key.
 struct RowKey {
     double origin_y = 0.0;
     double origin_z_front = 0.0, origin_z_back = 0.0;
     double angle_front_deg = 0.0, angle_back_deg = 0.0;
-    int rows = 0;
+    double spacing = 0.0;
 };
 
 struct FaceParams {
@@ -60,6 +64,7 @@ struct FaceParams {
     double front_half_angle_deg = 0.0;
     std::vector<RowKey> upper_rows;  // from eye level (angle 0) up to the crown
     std::vector<RowKey> lower_rows;  // from eye level down to the neck's cut
+    double row_spacing = 0.0;        // mm between rows where a key gives none
     int eyeball_rings = 0, eyeball_segments = 0;
     int texture_size = 0;
 
@@ -67,7 +72,7 @@ struct FaceParams {
     Ellipsoid skull, lower_face, jaw;
     double neck_centre_z = 0.0;
     Vec2 neck_radii{};
-    double neck_top_y = 0.0;
+    double neck_top_y = 0.0, neck_blend = 0.0;
     double blend = 0.0;
 
     // eyes (left eye; the right one mirrors it)

@@ -9,8 +9,11 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 double ellipsoid_field(V3 p, const Ellipsoid& e) {
-    const V3 q{(p.x - e.centre[0]) / e.radii[0], (p.y - e.centre[1]) / e.radii[1],
-               (p.z - e.centre[2]) / e.radii[2]};
+    const double t = e.tilt_deg * kPi / 180.0;
+    const V3 d{p.x - e.centre[0], p.y - e.centre[1], p.z - e.centre[2]};
+    const double ly = d.y * std::cos(t) + d.z * std::sin(t);
+    const double lz = -d.y * std::sin(t) + d.z * std::cos(t);
+    const V3 q{d.x / e.radii[0], ly / e.radii[1], lz / e.radii[2]};
     const double rmin = std::min({e.radii[0], e.radii[1], e.radii[2]});
     return (length(q) - 1.0) * rmin;
 }
@@ -116,7 +119,7 @@ double FaceShape::field(V3 p) const {
     const double qx = p.x / p_.neck_radii[0], qz = (p.z - p_.neck_centre_z) / p_.neck_radii[1];
     const double cyl = (std::sqrt(qx * qx + qz * qz) - 1.0) * std::min(p_.neck_radii[0], p_.neck_radii[1]);
     const double neck = std::max(cyl, p.y - p_.neck_top_y);
-    return smooth_min(f, neck, p_.blend);
+    return smooth_min(f, neck, p_.neck_blend);
 }
 
 V3 FaceShape::field_normal(V3 p) const {
@@ -232,11 +235,12 @@ double FaceShape::ear_relief(double y, double z) const {
     const double rho = std::sqrt(u * u + v * v);
     if (rho >= 1.0) return 0.0;
     const double H = p_.ear_height;
-    double h = H * (1.0 - smoothstep(0.86, 1.0, rho));
-    h += 0.25 * H * std::exp(-std::pow((rho - 0.8) / 0.09, 2));                       // helix rim
-    h -= 0.55 * H * std::exp(-(std::pow((u + 0.1) / 0.38, 2) + std::pow((v - 0.12) / 0.3, 2)));  // concha
-    // Attached at the front, free at the back.
-    h *= mix(1.0, 0.55, smoothstep(-0.2, 0.8, v));
+    // Attached along the front edge (v > 0), standing off the head behind.
+    const double flare = 0.3 + 0.7 * smoothstep(0.7, -0.7, v);
+    const double outline = 1.0 - smoothstep(0.8, 1.0, rho);
+    double h = H * flare * outline;
+    h += 0.2 * H * flare * std::exp(-std::pow((rho - 0.78) / 0.08, 2));  // helix rim
+    h -= 0.45 * H * flare * std::exp(-(std::pow((u + 0.15) / 0.34, 2) + std::pow((v - 0.05) / 0.3, 2)));  // concha
     return std::max(h, 0.0);
 }
 

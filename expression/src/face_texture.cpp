@@ -95,20 +95,23 @@ double Painter::brow_density(double x, double y) const {
 
 bool Painter::hair(V3 q, double* amount) const {
     const double ax = std::abs(q.x);
-    double edge;  // > 0 inside the hair, in mm
-    if (q.z > p_.sideburn_z) {
-        const double tx = std::min(ax / p_.hairline_temple[0], 1.0);
-        const double line = mix(p_.hairline_y, p_.hairline_temple[1], tx * tx) +
-                            (ax > p_.hairline_temple[0] ? -(ax - p_.hairline_temple[0]) * 2.0 : 0.0);
-        edge = q.y - line;
-    } else {
-        const double bottom = mix(p_.sideburn_bottom_y, p_.hair_back_bottom_y, smoothstep(p_.sideburn_z, -70.0, q.z));
-        edge = q.y - bottom;
-        // Leave the ears bare.
-        if (s_.ear_relief(q.y, q.z) > 0.5 && ax > 60) edge = std::min(edge, -2.0);
-        // Sideburn: blend with the front hairline where the two meet.
-        edge = std::min(edge, (p_.sideburn_z - q.z) * 2.0 + 40.0);
-    }
+    // Front: the hairline over the forehead, dropping at the temples.
+    const double tx = std::min(ax / p_.hairline_temple[0], 1.0);
+    const double front_line = mix(p_.hairline_y, p_.hairline_temple[1], tx * tx) -
+                              std::max(ax - p_.hairline_temple[0], 0.0) * 2.5;
+    // Side and back, by depth: the sideburn in front of the ear, a margin
+    // over the ear, then down to the nape.
+    const double ear_top = p_.ear_centre_yz[0] + p_.ear_radii_yz[0] + 5.0;
+    const double ear_front = p_.ear_centre_yz[1] + p_.ear_radii_yz[1] + 3.0;
+    const double ear_back = p_.ear_centre_yz[1] - p_.ear_radii_yz[1] - 3.0;
+    double side_line;
+    if (q.z > ear_front) side_line = mix(ear_top, p_.sideburn_bottom_y, smoothstep(ear_front, ear_front + 5.0, q.z));
+    else if (q.z > ear_back) side_line = ear_top;
+    else side_line = mix(ear_top, p_.hair_back_bottom_y, smoothstep(ear_back, ear_back - 35.0, q.z));
+    const double line = mix(side_line, front_line, smoothstep(p_.sideburn_z - 6.0, p_.sideburn_z + 6.0, q.z));
+    double edge = q.y - line;
+    // Leave the ears bare.
+    if (ax > 55 && s_.ear_relief(q.y, q.z) > 0.3) edge = std::min(edge, -2.0);
     edge += (noise(q.x * 0.4, q.y * 0.4, q.z * 0.4) - 0.5) * 3.0;
     *amount = smoothstep(-1.0, 2.5, edge);
     return *amount > 0.0;
