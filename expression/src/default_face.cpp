@@ -828,7 +828,8 @@ Face Generator::build(int texture_size) {
     place_feature_points(face);
     face.jaw_pivot = {p_.jaw_pivot[0], p_.jaw_pivot[1], p_.jaw_pivot[2]};
     face.head_pivot = {p_.head_pivot[0], p_.head_pivot[1], p_.head_pivot[2]};
-    face.texture_box = {p_.texture_box_min[0], p_.texture_box_min[1], p_.texture_box_max[0], p_.texture_box_max[1]};
+    face.texture_box.min = {float(p_.texture_box_min[0]), float(p_.texture_box_min[1])};
+    face.texture_box.max = {float(p_.texture_box_max[0]), float(p_.texture_box_max[1])};
     update_fapu(face);
     face.base_colour = detail::paint_base_colour(shape_, face.mesh, texture_size);
     return face;

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "emoface/expression/feature_layout.h"
 #include "emoface/expression/mesh.h"
 #include "emoface/fap/fapu.h"
 
@@ -70,11 +71,8 @@ struct Eyeball {
 };
 
 // The frontal box the projective texture layout maps to [0,1]^2 (DESIGN.md,
-// "Texture layouts"): u = (x - x_min) / (x_max - x_min), v = (y - y_min) /
-// (y_max - y_min) for a feature point's current (x, y).
-struct TextureBox {
-    double x_min = 0.0, y_min = 0.0, x_max = 1.0, y_max = 1.0;
-};
+// "Texture layouts") is expression::TextureBox of feature_layout.h (one type
+// for both headers; project_to_texture() gives u to the right, v down).
 
 // An RGBA8 image, rows stored top to bottom (row 0 is the image's top, as in
 // PNG files). Texture coordinates follow OBJ/OpenGL: v = 0 is the bottom row,
