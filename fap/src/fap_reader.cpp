@@ -348,6 +348,9 @@ private:
 }  // namespace
 
 FapStream parse_fap(std::string_view text, const std::string& source_name) {
+    // Windows editors may start a text file with a UTF-8 byte order mark.
+    constexpr std::string_view kBom = "\xEF\xBB\xBF";
+    if (text.substr(0, kBom.size()) == kBom) text.remove_prefix(kBom.size());
     return Reader(text, source_name).read();
 }
 

@@ -60,6 +60,7 @@ TEST(FapReader, StylesThatReadTheSame) {
     const Variant variants[] = {
         {"CRLF", replace_all(kCanonical, "\n", "\r\n")},
         {"lone CR", replace_all(kCanonical, "\n", "\r")},
+        {"UTF-8 byte order mark", "\xEF\xBB\xBF" + kCanonical},
         {"tabs", replace_all(kCanonical, " ", "\t")},
         {"trailing spaces and tabs", replace_all(kCanonical, "\n", " \t \n")},
         {"no final newline", kCanonical.substr(0, kCanonical.size() - 1)},

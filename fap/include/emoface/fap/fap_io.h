@@ -24,7 +24,8 @@
 // order. FAP 1 takes 4 values (select1 select2 blend def) or 1 (select1);
 // FAP 2 takes 6 (select1 intensity1 select2 intensity2 init_face def) or 1
 // (select1); the token count tells which. Values are integers or decimals.
-// Tokens are separated by spaces or tabs; lines end in LF, CRLF or CR.
+// Tokens are separated by spaces or tabs; lines end in LF, CRLF or CR; a
+// leading UTF-8 byte order mark is skipped.
 // Trailing frames that transmit nothing are dropped (with a warning): under
 // the untransmitted-FAP rule they change nothing (Greta writes one such frame
 // for an empty animation).
