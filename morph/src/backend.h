@@ -27,6 +27,7 @@ struct FramePlan {
     bool normal_map = false;
     Accuracy accuracy = Accuracy::Exact;
     int fast_cell = 8;
+    float fast_reach = 4.0f;  // cells
     float extent = 1.0f;      // S = max(W, H): iso units to pixels
     float inv_extent = 1.0f;  // 1 / S
 };

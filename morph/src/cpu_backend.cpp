@@ -1,6 +1,7 @@
 // The CPU backend: the key maps copied once, the shared kernel body run over
 // rows by a thread pool with one thread per core.
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <vector>
 
@@ -18,6 +19,15 @@ const CpuKernels& pick_kernels() {
     return cpu_base::kernels();
 }
 
+// EMOFACE_MORPH_THREADS=n overrides the thread count (benchmarks, profiling).
+int thread_count() {
+    if (const char* v = std::getenv("EMOFACE_MORPH_THREADS")) {
+        const int n = std::atoi(v);
+        if (n > 0 && n <= 1024) return n;
+    }
+    return 0;
+}
+
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
@@ -27,7 +37,7 @@ class CpuBackend final : public BackendImpl {
 public:
     CpuBackend(int width, int height, PixelFormat format, const std::vector<KeyMap>& keys)
         : width_(width), height_(height), is_float_(format == PixelFormat::RgbaF32),
-          kernels_(pick_kernels()) {
+          kernels_(pick_kernels()), pool_(thread_count()) {
         const std::size_t bytes = static_cast<std::size_t>(width) * height * (is_float_ ? 16 : 4);
         auto t0 = Clock::now();
         keys_.resize(keys.size());
@@ -63,11 +73,13 @@ public:
         // more so every pixel lies inside a cell.
         job.grid_w = (width_ - 1) / plan.fast_cell + 2;
         job.grid_h = (height_ - 1) / plan.fast_cell + 2;
-        const std::size_t grid_floats = static_cast<std::size_t>(job.grid_w) * job.grid_h * 2 * plan.sources;
+        const std::size_t grid_floats =
+            static_cast<std::size_t>(job.grid_w) * job.grid_h * kernel::sum_floats(plan.sources);
         if (grid_.size() < grid_floats) grid_.resize(grid_floats);  // first use / finer cell only
         job.grid = grid_.data();
         pool_.parallel_for(job.grid_h, 1, [&](int g0, int g1) { kernels_.grid_rows(job, g0, g1); });
-        pool_.parallel_for(height_, 4, [&](int y0, int y1) { kernels_.apply_rows(job, y0, y1); });
+        const int cell_rows = (height_ + plan.fast_cell - 1) / plan.fast_cell;
+        pool_.parallel_for(cell_rows, 1, [&](int t0, int t1) { kernels_.apply_rows(job, t0, t1); });
     }
 
 private:

@@ -5,6 +5,9 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "backend.h"
 #include "emoface/morph/kernel.h"
@@ -20,8 +23,8 @@ struct CpuJob {
     unsigned char* out = nullptr;
     std::size_t out_pitch = 0;
     float* positions = nullptr;
-    // Fast mode: displacements (pixels) at grid points (i·cell + 0.5, j·cell + 0.5),
-    // grid_w x grid_h points, plan->sources float pairs each.
+    // Fast mode: the sums of all lines (kernel::sum_floats(sources) floats) at
+    // grid points (i·cell + 0.5, j·cell + 0.5), grid_w x grid_h of them.
     float* grid = nullptr;
     int grid_w = 0, grid_h = 0;
 };
@@ -30,10 +33,10 @@ struct CpuKernels {
     const char* name;
     // Exact warp of rows [y0, y1).
     void (*exact_rows)(const CpuJob& job, int y0, int y1);
-    // Fast mode, pass 1: grid rows [g0, g1).
+    // Fast mode, pass 1: grid rows [g0, g1) of sums.
     void (*grid_rows)(const CpuJob& job, int g0, int g1);
-    // Fast mode, pass 2: rows [y0, y1) from the grid.
-    void (*apply_rows)(const CpuJob& job, int y0, int y1);
+    // Fast mode, pass 2: cell rows [t0, t1) from the grid and the near lines.
+    void (*apply_rows)(const CpuJob& job, int t0, int t1);
 };
 
 namespace cpu_base {
@@ -56,7 +59,43 @@ using kernel::Law;
 // the sums of 8 sources stay in L1 (17 x 64 floats).
 constexpr int kRun = 64;
 
-inline void store_pixel(const CpuJob& job, int x, int y, const kernel::Rgba& c) {
+#if defined(__GNUC__)
+#define EMOFACE_CPU_INLINE inline __attribute__((always_inline))
+#else
+#define EMOFACE_CPU_INLINE inline
+#endif
+
+#if defined(__SSE2__)
+// The per-pixel end on x86: the same bilinear sample and blend as
+// kernel::blend_sources (same clamping, same lerp order), with the four
+// channels of a texel in one SSE register instead of four scalars.
+EMOFACE_CPU_INLINE __m128 texel_ps(const kernel::ImageView& img, const unsigned char* row, int x) {
+    if (img.is_float) return _mm_loadu_ps(reinterpret_cast<const float*>(row) + 4 * x);
+    int bytes;
+    std::memcpy(&bytes, row + 4 * x, 4);
+    const __m128i zero = _mm_setzero_si128();
+    const __m128i v = _mm_unpacklo_epi16(_mm_unpacklo_epi8(_mm_cvtsi32_si128(bytes), zero), zero);
+    return _mm_cvtepi32_ps(v);
+}
+
+EMOFACE_CPU_INLINE __m128 sample_ps(const kernel::ImageView& img, float px, float py) {
+    const float fx = kernel::clampf(px - 0.5f, 0.0f, static_cast<float>(img.width - 1));
+    const float fy = kernel::clampf(py - 0.5f, 0.0f, static_cast<float>(img.height - 1));
+    const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
+    const int x1 = x0 + 1 < img.width ? x0 + 1 : x0;
+    const int y1 = y0 + 1 < img.height ? y0 + 1 : y0;
+    const __m128 tx = _mm_set1_ps(fx - static_cast<float>(x0)), ty = _mm_set1_ps(fy - static_cast<float>(y0));
+    const unsigned char* r0 = img.base + static_cast<std::size_t>(y0) * img.pitch;
+    const unsigned char* r1 = img.base + static_cast<std::size_t>(y1) * img.pitch;
+    const __m128 a = texel_ps(img, r0, x0), b = texel_ps(img, r0, x1);
+    const __m128 c = texel_ps(img, r1, x0), d = texel_ps(img, r1, x1);
+    const __m128 top = _mm_add_ps(a, _mm_mul_ps(tx, _mm_sub_ps(b, a)));
+    const __m128 bottom = _mm_add_ps(c, _mm_mul_ps(tx, _mm_sub_ps(d, c)));
+    return _mm_add_ps(top, _mm_mul_ps(ty, _mm_sub_ps(bottom, top)));
+}
+#endif
+
+EMOFACE_CPU_INLINE void store_pixel(const CpuJob& job, int x, int y, const kernel::Rgba& c) {
     unsigned char* row = job.out + static_cast<std::size_t>(y) * job.out_pitch;
     if (job.keys[0].is_float) {
         float* p = reinterpret_cast<float*>(row) + 4 * x;
@@ -72,7 +111,7 @@ inline void store_pixel(const CpuJob& job, int x, int y, const kernel::Rgba& c) 
 
 // Writes point results: positions, or the sampled and blended pixel.
 template <int K>
-inline void finish_point(const CpuJob& job, int x, int y, const float (&dx)[K], const float (&dy)[K]) {
+EMOFACE_CPU_INLINE void finish_point(const CpuJob& job, int x, int y, const float (&dx)[K], const float (&dy)[K]) {
     const float px = static_cast<float>(x) + 0.5f, py = static_cast<float>(y) + 0.5f;
     if (job.positions != nullptr) {
         float* p = job.positions + (static_cast<std::size_t>(y) * job.width + x) * (2 * K);
@@ -82,8 +121,20 @@ inline void finish_point(const CpuJob& job, int x, int y, const float (&dx)[K], 
         }
         return;
     }
+#if defined(__SSE2__)
+    __m128 sum = _mm_setzero_ps();
+    for (int k = 0; k < K; ++k)
+        sum = _mm_add_ps(sum, _mm_mul_ps(_mm_set1_ps(job.plan->weight[k]),
+                                         sample_ps(job.keys[k], px + dx[k], py + dy[k])));
+    alignas(16) float c[4];
+    _mm_store_ps(c, sum);
+    kernel::Rgba rgba{c[0], c[1], c[2], c[3]};
+    if (job.plan->normal_map) rgba = kernel::renormalise(rgba, job.keys[0].is_float ? 1.0f : 255.0f);
+    store_pixel(job, x, y, rgba);
+#else
     store_pixel(job, x, y,
                 kernel::blend_sources<K>(job.keys, job.plan->weight, px, py, dx, dy, job.plan->normal_map));
+#endif
 }
 
 // Sums all lines for kRun points spaced `spacing` pixels apart on pixel row
@@ -114,10 +165,13 @@ void exact_rows_t(const CpuJob& job, int y0, int y1) {
     }
 }
 
+// Fast mode, pass 1: the sums of all lines at grid points (i·cell + 0.5,
+// j·cell + 0.5), kernel::sum_floats(K) floats each.
 template <int K, Law L>
 void grid_rows_t(const CpuJob& job, int g0, int g1) {
     const FramePlan& plan = *job.plan;
     const float cell = static_cast<float>(plan.fast_cell);
+    constexpr int S = kernel::sum_floats(K);
     Accum<K, kRun> acc;
     for (int gy = g0; gy < g1; ++gy) {
         for (int gx0 = 0; gx0 < job.grid_w; gx0 += kRun) {
@@ -125,49 +179,93 @@ void grid_rows_t(const CpuJob& job, int g0, int g1) {
                             acc);
             const int n = job.grid_w - gx0 < kRun ? job.grid_w - gx0 : kRun;
             for (int j = 0; j < n; ++j) {
-                float dx[K], dy[K];
-                kernel::displacement(acc, j, plan.extent, dx, dy);
-                float* g = job.grid + (static_cast<std::size_t>(gy) * job.grid_w + gx0 + j) * (2 * K);
+                float* g = job.grid + (static_cast<std::size_t>(gy) * job.grid_w + gx0 + j) * S;
+                g[0] = acc.w[j];
                 for (int k = 0; k < K; ++k) {
-                    g[2 * k] = dx[k];
-                    g[2 * k + 1] = dy[k];
+                    g[1 + 2 * k] = acc.dx[k][j];
+                    g[2 + 2 * k] = acc.dy[k][j];
                 }
             }
         }
     }
 }
 
-// Pass 2: bilinear interpolation of the grid. A run of `cell` pixels shares
-// one grid cell: interpolate its two columns in y once, then along x.
-template <int K>
-void apply_rows_t(const CpuJob& job, int y0, int y1) {
-    const int cell = job.plan->fast_cell;
-    const float inv_cell = 1.0f / static_cast<float>(cell);
-    for (int y = y0; y < y1; ++y) {
-        const int gy = y / cell;
-        const float fy = static_cast<float>(y - gy * cell) * inv_cell;
-        const float* top = job.grid + static_cast<std::size_t>(gy) * job.grid_w * (2 * K);
-        const float* bottom = top + static_cast<std::size_t>(job.grid_w) * (2 * K);
-        for (int x0 = 0; x0 < job.width; x0 += cell) {
-            const int gx = x0 / cell;
-            float left[2 * K], right[2 * K];
-            for (int c = 0; c < 2 * K; ++c) {
-                const float* t = top + gx * (2 * K) + c;
-                const float* b = bottom + gx * (2 * K) + c;
-                left[c] = t[0] + fy * (b[0] - t[0]);
-                right[c] = t[2 * K] + fy * (b[2 * K] - t[2 * K]);
-            }
-            const int n = job.width - x0 < cell ? job.width - x0 : cell;
-            for (int j = 0; j < n; ++j) {
-                const float fx = static_cast<float>(j) * inv_cell;
-                float dx[K], dy[K];
-                for (int k = 0; k < K; ++k) {
-                    dx[k] = left[2 * k] + fx * (right[2 * k] - left[2 * k]);
-                    dy[k] = left[2 * k + 1] + fx * (right[2 * k + 1] - left[2 * k + 1]);
+// Fast mode, pass 2, for cell rows [t0, t1): per cell, its near lines;
+// the far sums at its corners; per pixel row, the far sums interpolated
+// along the row plus the near lines' exact terms (kernel.h, "fast mode").
+template <int K, Law L, int C>
+void fast_tiles_t(const CpuJob& job, int t0, int t1) {
+    const FramePlan& plan = *job.plan;
+    constexpr int S = kernel::sum_floats(K);
+    const float inv = plan.inv_extent;
+    const float reach = (plan.fast_reach + 0.70711f) * static_cast<float>(C) * inv;
+    const int tiles_w = (job.width + C - 1) / C;
+    unsigned short list[kernel::kMaxNear];
+    Accum<K, C> acc;
+    for (int ty = t0; ty < t1; ++ty) {
+        for (int tx = 0; tx < tiles_w; ++tx) {
+            const float cx = (static_cast<float>(tx * C) + 0.5f + 0.5f * C) * inv;
+            const float cy = (static_cast<float>(ty * C) + 0.5f + 0.5f * C) * inv;
+            const int count = kernel::near_lines(plan.records, plan.record_floats, plan.lines, cx, cy, reach, list);
+            const bool exact = count > kernel::kMaxNear;
+            float corner[4][S];
+            if (!exact) {
+                for (int c = 0; c < 4; ++c) {
+                    const int gx = tx + (c & 1), gy = ty + (c >> 1);
+                    kernel::far_sums<K, L>(job.grid + (static_cast<std::size_t>(gy) * job.grid_w + gx) * S,
+                                           plan.records, plan.record_floats, list, count,
+                                           (static_cast<float>(gx * C) + 0.5f) * inv,
+                                           (static_cast<float>(gy * C) + 0.5f) * inv, plan.b, corner[c]);
                 }
-                finish_point<K>(job, x0 + j, y, dx, dy);
+            }
+            const int x0 = tx * C;
+            for (int r = 0; r < C; ++r) {
+                const int y = ty * C + r;
+                if (y >= job.height) break;
+                const float x_iso = (static_cast<float>(x0) + 0.5f) * inv;
+                const float y_iso = (static_cast<float>(y) + 0.5f) * inv;
+                if (exact) {
+                    acc.clear();
+                    for (int l = 0; l < plan.lines; ++l)
+                        kernel::accumulate_line<K, C, L>(plan.records + static_cast<std::size_t>(l) * plan.record_floats,
+                                                         x_iso, y_iso, inv, plan.b, acc);
+                } else {
+                    const float fy = static_cast<float>(r) / C;
+                    float left[S], right[S];
+                    for (int q = 0; q < S; ++q) {
+                        left[q] = corner[0][q] + fy * (corner[2][q] - corner[0][q]);
+                        right[q] = corner[1][q] + fy * (corner[3][q] - corner[1][q]);
+                    }
+                    for (int j = 0; j < C; ++j) {
+                        const float fx = static_cast<float>(j) / C;
+                        acc.w[j] = left[0] + fx * (right[0] - left[0]);
+                        for (int k = 0; k < K; ++k) {
+                            acc.dx[k][j] = left[1 + 2 * k] + fx * (right[1 + 2 * k] - left[1 + 2 * k]);
+                            acc.dy[k][j] = left[2 + 2 * k] + fx * (right[2 + 2 * k] - left[2 + 2 * k]);
+                        }
+                    }
+                    for (int n = 0; n < count; ++n)
+                        kernel::accumulate_line<K, C, L>(plan.records + list[n] * plan.record_floats, x_iso, y_iso,
+                                                         inv, plan.b, acc);
+                }
+                const int run = job.width - x0 < C ? job.width - x0 : C;
+                for (int j = 0; j < run; ++j) {
+                    float dx[K], dy[K];
+                    kernel::displacement(acc, j, plan.extent, dx, dy);
+                    finish_point<K>(job, x0 + j, y, dx, dy);
+                }
             }
         }
+    }
+}
+
+template <int K, Law L>
+void apply_rows_t(const CpuJob& job, int t0, int t1) {
+    switch (job.plan->fast_cell) {
+        case 4: fast_tiles_t<K, L, 4>(job, t0, t1); break;
+        case 8: fast_tiles_t<K, L, 8>(job, t0, t1); break;
+        case 16: fast_tiles_t<K, L, 16>(job, t0, t1); break;
+        default: fast_tiles_t<K, L, 32>(job, t0, t1); break;
     }
 }
 
@@ -187,28 +285,14 @@ void apply_rows_t(const CpuJob& job, int y0, int y1) {
         }                                                                                \
     } while (0)
 
-#define EMOFACE_CPU_DISPATCH_K(fn, plan, ...)      \
-    do {                                           \
-        switch ((plan).sources) {                  \
-            case 1: fn<1>(__VA_ARGS__); break;     \
-            case 2: fn<2>(__VA_ARGS__); break;     \
-            case 3: fn<3>(__VA_ARGS__); break;     \
-            case 4: fn<4>(__VA_ARGS__); break;     \
-            case 5: fn<5>(__VA_ARGS__); break;     \
-            case 6: fn<6>(__VA_ARGS__); break;     \
-            case 7: fn<7>(__VA_ARGS__); break;     \
-            default: fn<8>(__VA_ARGS__); break;    \
-        }                                          \
-    } while (0)
-
 inline void exact_rows(const CpuJob& job, int y0, int y1) {
     EMOFACE_CPU_DISPATCH_KL(exact_rows_t, *job.plan, job, y0, y1);
 }
 inline void grid_rows(const CpuJob& job, int g0, int g1) {
     EMOFACE_CPU_DISPATCH_KL(grid_rows_t, *job.plan, job, g0, g1);
 }
-inline void apply_rows(const CpuJob& job, int y0, int y1) {
-    EMOFACE_CPU_DISPATCH_K(apply_rows_t, *job.plan, job, y0, y1);
+inline void apply_rows(const CpuJob& job, int t0, int t1) {
+    EMOFACE_CPU_DISPATCH_KL(apply_rows_t, *job.plan, job, t0, t1);
 }
 
 const CpuKernels& kernels() {

@@ -107,6 +107,9 @@ struct Morpher::Impl {
             const int c = params.fast_cell;
             if (c != 4 && c != 8 && c != 16 && c != 32)
                 fail<InputError>("morph: {}(): params.fast_cell = {}, expected 4, 8, 16 or 32", fn, c);
+            if (!(std::isfinite(params.fast_reach) && params.fast_reach >= 0.0f && params.fast_reach <= 64.0f))
+                fail<InputError>("morph: {}(): params.fast_reach = {}, expected a value in [0, 64] (cells)", fn,
+                                 params.fast_reach);
         }
     }
 
@@ -148,6 +151,7 @@ struct Morpher::Impl {
         plan.normal_map = params.normal_map;
         plan.accuracy = params.accuracy;
         plan.fast_cell = params.fast_cell;
+        plan.fast_reach = params.fast_reach;
         plan.extent = static_cast<float>(extent);
         plan.inv_extent = static_cast<float>(1.0 / extent);
 

@@ -329,8 +329,8 @@ TEST(MorphFast, AffineFieldsAreInterpolatedExactly) {
     }
 }
 
-TEST(MorphFast, ErrorShrinksWithTheCellAndMatchesTheGridAtGridPoints) {
-    const int w = 128, h = 128;
+TEST(MorphFast, ExactNearLinesBoundTheError) {
+    const int w = 160, h = 128;
     const auto img = random_rgba8(w, h, 111);
     const Layout base = random_layout(12, 112), target = jitter(base, 0.03f, 113);
     Morpher m(w, h, PixelFormat::Rgba8, {key(img.data(), base)}, Backend::Cpu);
@@ -338,22 +338,31 @@ TEST(MorphFast, ErrorShrinksWithTheCellAndMatchesTheGridAtGridPoints) {
     MorphParams params;
     m.positions_to_host(target, params, exact.data());
     params.accuracy = Accuracy::Fast;
-    double previous = 1e9;
-    for (int cell : {32, 8}) {
-        params.fast_cell = cell;
+    params.fast_cell = 8;
+    auto errors = [&](float reach, double& worst, double& at_grid) {
+        params.fast_reach = reach;
         m.positions_to_host(target, params, fast.data());
-        double worst = 0.0, at_grid = 0.0;
+        worst = at_grid = 0.0;
         for (int y = 0; y < h; ++y)
             for (int x = 0; x < w; ++x) {
                 const std::size_t i = (static_cast<std::size_t>(y) * w + x) * 2;
                 const double e = std::hypot(fast[i] - exact[i], fast[i + 1] - exact[i + 1]);
                 worst = std::fmax(worst, e);
-                if (x % cell == 0 && y % cell == 0) at_grid = std::fmax(at_grid, e);
+                if (x % 8 == 0 && y % 8 == 0) at_grid = std::fmax(at_grid, e);
             }
-        EXPECT_LT(at_grid, 1e-3) << "cell " << cell << ": grid points are evaluated exactly";
-        EXPECT_LT(worst, previous) << "cell " << cell;
-        previous = worst;
-    }
+    };
+    double plain, plain_grid, near1, near1_grid, near4, near4_grid, all, all_grid;
+    errors(0.0f, plain, plain_grid);  // plain interpolation: the kinks across lines are smoothed over
+    errors(1.0f, near1, near1_grid);
+    errors(4.0f, near4, near4_grid);
+    errors(64.0f, all, all_grid);  // every line near every cell: exact everywhere
+    EXPECT_LT(plain_grid, 1e-3) << "grid points are evaluated exactly";
+    EXPECT_LT(near4_grid, 1e-3);
+    EXPECT_GT(plain, 0.1) << "a test layout with nothing to interpolate proves nothing";
+    EXPECT_LT(near1, plain);
+    EXPECT_LT(near4, near1);
+    EXPECT_LT(near4, 0.1);
+    EXPECT_LT(all, 1e-3);
 }
 
 // ---- backends ------------------------------------------------------------------------

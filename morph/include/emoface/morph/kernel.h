@@ -28,6 +28,16 @@
 
 #include "emoface/common/hd.h"
 
+// Everything here is small and called in the innermost loops: force inlining
+// on the host too (plain `inline` lets the compiler keep calls there).
+#if defined(__CUDACC__)
+#define EMOFACE_MORPH_INLINE EMOFACE_INLINE
+#elif defined(__GNUC__)
+#define EMOFACE_MORPH_INLINE inline __attribute__((always_inline))
+#else
+#define EMOFACE_MORPH_INLINE inline
+#endif
+
 // EMOFACE_UNROLL: loops over sources (at most kMaxKeys) and other short
 // compile-time loops, unrolled on both sides. EMOFACE_PIXEL_LOOP: the loop over
 // a run of points, unrolled into registers on the GPU (1 or 4 points) and
@@ -72,7 +82,7 @@ struct Rgba {
 
 // ---- fast math shared by both sides ---------------------------------------
 
-EMOFACE_HD EMOFACE_INLINE float fast_sqrt(float x) {
+EMOFACE_HD EMOFACE_MORPH_INLINE float fast_sqrt(float x) {
 #if defined(__CUDA_ARCH__)
     float r;
     asm("sqrt.approx.ftz.f32 %0, %1;" : "=f"(r) : "f"(x));
@@ -82,7 +92,7 @@ EMOFACE_HD EMOFACE_INLINE float fast_sqrt(float x) {
 #endif
 }
 
-EMOFACE_HD EMOFACE_INLINE float fast_rcp(float x) {
+EMOFACE_HD EMOFACE_MORPH_INLINE float fast_rcp(float x) {
 #if defined(__CUDA_ARCH__)
     float r;
     asm("rcp.approx.ftz.f32 %0, %1;" : "=f"(r) : "f"(x));
@@ -92,7 +102,7 @@ EMOFACE_HD EMOFACE_INLINE float fast_rcp(float x) {
 #endif
 }
 
-EMOFACE_HD EMOFACE_INLINE float pow_neg(float q, float b) {
+EMOFACE_HD EMOFACE_MORPH_INLINE float pow_neg(float q, float b) {
 #if defined(__CUDA_ARCH__)
     return exp2f(-b * __log2f(q));
 #else
@@ -101,16 +111,23 @@ EMOFACE_HD EMOFACE_INLINE float pow_neg(float q, float b) {
 }
 
 // Branch-free helpers the CPU compiler turns into max/min/and instructions
-// (std::fmax's NaN rules would stop it vectorising).
-EMOFACE_HD EMOFACE_INLINE float max0(float x) { return x > 0.0f ? x : 0.0f; }
-EMOFACE_HD EMOFACE_INLINE float absf(float x) { return x < 0.0f ? -x : x; }
-EMOFACE_HD EMOFACE_INLINE float clampf(float x, float lo, float hi) {
+// (std::fmax's NaN rules would stop it vectorising); fabs is a sign-bit
+// mask on the CPU and a free operand modifier on the GPU.
+EMOFACE_HD EMOFACE_MORPH_INLINE float max0(float x) { return x > 0.0f ? x : 0.0f; }
+EMOFACE_HD EMOFACE_MORPH_INLINE float absf(float x) {
+#if defined(__CUDA_ARCH__)
+    return fabsf(x);
+#else
+    return std::fabs(x);
+#endif
+}
+EMOFACE_HD EMOFACE_MORPH_INLINE float clampf(float x, float lo, float hi) {
     // NaN compares false both ways and ends up at lo: never an out-of-range index.
     return x > lo ? (x < hi ? x : hi) : lo;
 }
 
 template <Law L>
-EMOFACE_HD EMOFACE_INLINE float line_weight(float q, float b) {
+EMOFACE_HD EMOFACE_MORPH_INLINE float line_weight(float q, float b) {
     if constexpr (L == Law::InverseSquare) {
         const float r = fast_rcp(q);
         return r * r;
@@ -128,7 +145,7 @@ struct Accum {
     float dx[K][PX];
     float dy[K][PX];
 
-    EMOFACE_HD EMOFACE_INLINE void clear() {
+    EMOFACE_HD EMOFACE_MORPH_INLINE void clear() {
         EMOFACE_PIXEL_LOOP
         for (int j = 0; j < PX; ++j) w[j] = 0.0f;
         EMOFACE_UNROLL
@@ -146,7 +163,7 @@ struct Accum {
 // in iso units. `rec` is one line record with K sources. u, v and w are
 // computed once per point and reused for every source.
 template <int K, int PX, Law L>
-EMOFACE_HD EMOFACE_INLINE void accumulate_line(const float* rec, float x0, float y, float step,
+EMOFACE_HD EMOFACE_MORPH_INLINE void accumulate_line(const float* rec, float x0, float y, float step,
                                                float b, Accum<K, PX>& acc) {
     const float ex = rec[kEx], ey = rec[kEy];
     const float nx = rec[kNx], ny = rec[kNy];
@@ -158,8 +175,9 @@ EMOFACE_HD EMOFACE_INLINE void accumulate_line(const float* rec, float x0, float
     const float* src = rec + kGeomFloats;
     EMOFACE_PIXEL_LOOP
     for (int j = 0; j < PX; ++j) {
-        const float s = s0 + static_cast<float>(j) * s_step;
-        const float v = v0 + static_cast<float>(j) * v_step;
+        // (j == 0 spelled out: the GPU's unrolled first point then costs nothing)
+        const float s = j == 0 ? s0 : s0 + static_cast<float>(j) * s_step;
+        const float v = j == 0 ? v0 : v0 + static_cast<float>(j) * v_step;
         const float beyond = max0(absf(s) - half_len);
         const float dist = fast_sqrt(v * v + beyond * beyond);
         const float w = line_weight<L>(dist * wk + wa, b);
@@ -176,13 +194,80 @@ EMOFACE_HD EMOFACE_INLINE void accumulate_line(const float* rec, float x0, float
 // Displacement of point j for source k, in pixels: Σ w D / Σ w scaled by S.
 // With no lines (Σw = 0) the warp is the identity.
 template <int K, int PX>
-EMOFACE_HD EMOFACE_INLINE void displacement(const Accum<K, PX>& acc, int j, float extent,
+EMOFACE_HD EMOFACE_MORPH_INLINE void displacement(const Accum<K, PX>& acc, int j, float extent,
                                             float (&dx)[K], float (&dy)[K]) {
     const float scale = acc.w[j] > 0.0f ? extent / acc.w[j] : 0.0f;
     EMOFACE_UNROLL
     for (int k = 0; k < K; ++k) {
         dx[k] = acc.dx[k][j] * scale;
         dy[k] = acc.dy[k][j] * scale;
+    }
+}
+
+// ---- fast mode: far lines from a coarse grid, near lines exactly -------------
+//
+// The displacement is a ratio of sums, D = Σ w_i D_i / Σ w_i. A line's terms
+// are smooth wherever the point is off its segment: the weight changes on the
+// scale a + dist, and D_i is affine. Across the segment, dist = |v| has a
+// kink. So for each grid cell (fast_cell pixels square) the lines that pass
+// within `reach` of it ("near" lines) are evaluated exactly at each pixel,
+// and the sums of all other lines are interpolated bilinearly from the grid
+// (whose points hold the sums of all lines, less the near lines' terms at
+// the cell's corners). The interpolation error of a far line's terms shrinks
+// as (cell / reach)²; the kinks are never interpolated.
+
+inline constexpr int kMaxNear = 16;  // more near lines: the cell is done exactly
+EMOFACE_HD constexpr int sum_floats(int sources) { return 1 + 2 * sources; }
+
+// Distance (iso units) from point (x, y) to a line's segment.
+EMOFACE_HD EMOFACE_MORPH_INLINE float segment_distance(const float* rec, float x, float y) {
+    const float s = x * rec[kEx] + (y * rec[kEy] + rec[kCs]);
+    const float v = x * rec[kNx] + (y * rec[kNy] + rec[kCv]);
+    const float beyond = max0(absf(s) - rec[kHalfLen]);
+    return fast_sqrt(v * v + beyond * beyond);
+}
+
+// The lines whose segment comes within `reach` of a point (a cell's centre,
+// with reach including the cell's half-diagonal). Writes at most kMaxNear
+// indices; returns the full count.
+EMOFACE_HD EMOFACE_MORPH_INLINE int near_lines(const float* records, int record_floats, int lines, float cx, float cy,
+                                         float reach, unsigned short* list) {
+    int count = 0;
+    for (int i = 0; i < lines; ++i) {
+        if (segment_distance(records + i * record_floats, cx, cy) < reach) {
+            if (count < kMaxNear) list[count] = static_cast<unsigned short>(i);
+            ++count;
+        }
+    }
+    return count;
+}
+
+// sums[0] = Σw, sums[1 + 2k] = Σ w Dx_k, sums[2 + 2k] = Σ w Dy_k (iso units).
+template <int K>
+EMOFACE_HD EMOFACE_MORPH_INLINE void store_sums(const Accum<K, 1>& acc, float* sums) {
+    sums[0] = acc.w[0];
+    EMOFACE_UNROLL
+    for (int k = 0; k < K; ++k) {
+        sums[1 + 2 * k] = acc.dx[k][0];
+        sums[2 + 2 * k] = acc.dy[k][0];
+    }
+}
+
+// The sums of the lines NOT in `list`, at a grid point holding the sums of
+// all lines.
+template <int K, Law L>
+EMOFACE_HD EMOFACE_MORPH_INLINE void far_sums(const float* grid_sums, const float* records, int record_floats,
+                                        const unsigned short* list, int count, float x, float y, float b,
+                                        float* out) {
+    Accum<K, 1> near;
+    near.clear();
+    for (int n = 0; n < count; ++n)
+        accumulate_line<K, 1, L>(records + list[n] * record_floats, x, y, 0.0f, b, near);
+    out[0] = grid_sums[0] - near.w[0];
+    EMOFACE_UNROLL
+    for (int k = 0; k < K; ++k) {
+        out[1 + 2 * k] = grid_sums[1 + 2 * k] - near.dx[k][0];
+        out[2 + 2 * k] = grid_sums[2 + 2 * k] - near.dy[k][0];
     }
 }
 
@@ -197,7 +282,7 @@ struct ImageView {
     bool is_float;
 };
 
-EMOFACE_HD EMOFACE_INLINE Rgba load_texel(const ImageView& img, int x, int y) {
+EMOFACE_HD EMOFACE_MORPH_INLINE Rgba load_texel(const ImageView& img, int x, int y) {
     const unsigned char* row = img.base + static_cast<std::size_t>(y) * img.pitch;
     if (img.is_float) {
         const float* p = reinterpret_cast<const float*>(row) + 4 * x;
@@ -208,7 +293,7 @@ EMOFACE_HD EMOFACE_INLINE Rgba load_texel(const ImageView& img, int x, int y) {
             static_cast<float>(p[3])};
 }
 
-EMOFACE_HD EMOFACE_INLINE float lerp2(float p, float q, float r, float s, float tx, float ty) {
+EMOFACE_HD EMOFACE_MORPH_INLINE float lerp2(float p, float q, float r, float s, float tx, float ty) {
     const float top = p + tx * (q - p);
     const float bottom = r + tx * (s - r);
     return top + ty * (bottom - top);
@@ -216,7 +301,7 @@ EMOFACE_HD EMOFACE_INLINE float lerp2(float p, float q, float r, float s, float 
 
 // Bilinear sample at pixel coordinates (px, py), pixel centres at i + 0.5,
 // clamped to the edge. RGBA8 values stay in 0..255 units.
-EMOFACE_HD EMOFACE_INLINE Rgba sample_bilinear(const ImageView& img, float px, float py) {
+EMOFACE_HD EMOFACE_MORPH_INLINE Rgba sample_bilinear(const ImageView& img, float px, float py) {
     const float fx = clampf(px - 0.5f, 0.0f, static_cast<float>(img.width - 1));
     const float fy = clampf(py - 0.5f, 0.0f, static_cast<float>(img.height - 1));
     const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
@@ -229,7 +314,7 @@ EMOFACE_HD EMOFACE_INLINE Rgba sample_bilinear(const ImageView& img, float px, f
             lerp2(a.b, b.b, c.b, d.b, tx, ty), lerp2(a.a, b.a, c.a, d.a, tx, ty)};
 }
 
-EMOFACE_HD EMOFACE_INLINE void add_weighted(Rgba& sum, const Rgba& c, float w) {
+EMOFACE_HD EMOFACE_MORPH_INLINE void add_weighted(Rgba& sum, const Rgba& c, float w) {
     sum.r += w * c.r;
     sum.g += w * c.g;
     sum.b += w * c.b;
@@ -239,7 +324,7 @@ EMOFACE_HD EMOFACE_INLINE void add_weighted(Rgba& sum, const Rgba& c, float w) {
 // A normal map stores 0.5 + 0.5 n (times 255 for RGBA8). The blend of unit
 // vectors is shorter than 1; renormalise it and keep the encoding. A blend that
 // cancels out (or no source at all) gives the flat normal +z.
-EMOFACE_HD EMOFACE_INLINE Rgba renormalise(Rgba c, float unit) {
+EMOFACE_HD EMOFACE_MORPH_INLINE Rgba renormalise(Rgba c, float unit) {
     const float inv_unit = 1.0f / unit;
     float nx = 2.0f * c.r * inv_unit - 1.0f;
     float ny = 2.0f * c.g * inv_unit - 1.0f;
@@ -258,12 +343,12 @@ EMOFACE_HD EMOFACE_INLINE Rgba renormalise(Rgba c, float unit) {
     return {(0.5f + 0.5f * nx) * unit, (0.5f + 0.5f * ny) * unit, (0.5f + 0.5f * nz) * unit, c.a};
 }
 
-EMOFACE_HD EMOFACE_INLINE unsigned char to_byte(float v) {
+EMOFACE_HD EMOFACE_MORPH_INLINE unsigned char to_byte(float v) {
     return static_cast<unsigned char>(clampf(v, 0.0f, 255.0f) + 0.5f);
 }
 
 // RGBA8 packed little-endian into one 32-bit word (r in the low byte).
-EMOFACE_HD EMOFACE_INLINE std::uint32_t pack_rgba8(const Rgba& c) {
+EMOFACE_HD EMOFACE_MORPH_INLINE std::uint32_t pack_rgba8(const Rgba& c) {
     return static_cast<std::uint32_t>(to_byte(c.r)) |
            (static_cast<std::uint32_t>(to_byte(c.g)) << 8) |
            (static_cast<std::uint32_t>(to_byte(c.b)) << 16) |
@@ -273,7 +358,7 @@ EMOFACE_HD EMOFACE_INLINE std::uint32_t pack_rgba8(const Rgba& c) {
 // Samples the K sources at X + D_k and blends them by weight: the per-pixel
 // end of the kernel, after the line loop.
 template <int K>
-EMOFACE_HD EMOFACE_INLINE Rgba blend_sources(const ImageView* keys, const float* weights, float px, float py, const float (&dx)[K],
+EMOFACE_HD EMOFACE_MORPH_INLINE Rgba blend_sources(const ImageView* keys, const float* weights, float px, float py, const float (&dx)[K],
                                              const float (&dy)[K], bool normal_map) {
     Rgba sum{0.0f, 0.0f, 0.0f, 0.0f};
     EMOFACE_UNROLL

@@ -1,0 +1,585 @@
+// The CUDA backend: the same kernel body (kernel.h) launched over the image.
+//
+// Setup (once): key maps in pitched device memory with a texture object over
+// each, one stream, and, when the line table is too large to pass as a kernel
+// parameter, a device table with a pinned staging buffer. A frame passes the
+// line table as a kernel parameter (up to 8 KB: N = 84 lines with 2 sources
+// fit) or copies it once to the device table, then launches:
+//   exact: warp_kernel over the pixels: lines staged in shared memory, u, v
+//          and the weight once per pixel-line for all sources, hand bilinear
+//          sampling (bit-compatible with the CPU), blend, store.
+//   fast:  warp_kernel over a grid every `fast_cell` pixels writing
+//          displacements, then apply_kernel over the pixels: bilinear
+//          interpolation of the grid and texture-unit sampling.
+// Nothing is allocated per frame; buffers for positions, host output and the
+// fast grid are allocated at their first use.
+#include <cuda_runtime.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "backend.h"
+#include "emoface/common/error.h"
+#include "emoface/morph/kernel.h"
+
+namespace emoface::morph::detail {
+namespace {
+
+using kernel::Accum;
+using kernel::Law;
+using kernel::kMaxKeys;
+
+void cuda_check(cudaError_t e, const char* what) {
+    if (e != cudaSuccess) fail<EnvironmentError>("morph: CUDA: {} failed: {}", what, cudaGetErrorString(e));
+}
+#define EMOFACE_CUDA_CHECK(call) cuda_check((call), #call)
+
+// Line records passed by value: 8 KB of kernel parameters (CUDA 12.1+ allows
+// up to 32 KB; 8 KB keeps the launch cheap and holds N = 84 with K = 2).
+constexpr int kParamTableFloat4 = 512;
+struct LineTable {
+    float4 rec[kParamTableFloat4];
+};
+
+enum class OutKind : int { Pixels, Surface, Displacement };
+
+struct KernelArgs {
+    const float4* lines;  // device table, or nullptr: the LineTable parameter
+    int n_lines;
+    int chunk_lines;  // lines staged in shared memory at a time
+    float extent, inv_extent, b;
+    int points_w, points_h;  // the lattice evaluated by warp_kernel
+    float spacing;           // pixels between lattice points
+    int width, height;
+    const unsigned char* key[kMaxKeys];
+    cudaTextureObject_t tex[kMaxKeys];
+    float weight[kMaxKeys];
+    std::size_t key_pitch;
+    int is_float;
+    int normal_map;
+    OutKind out_kind;
+    unsigned char* out;
+    std::size_t out_pitch;
+    int out_vector;  // out and out_pitch allow 16-byte stores
+    cudaSurfaceObject_t surface;
+    float2* disp;  // Displacement: [point][source] in pixels
+    const float2* grid;
+    int grid_w, cell;
+};
+
+__device__ __forceinline__ void store_pixel(const KernelArgs& a, int x, int y, const kernel::Rgba& c) {
+    if (a.out_kind == OutKind::Surface) {
+        if (a.is_float)
+            surf2Dwrite(make_float4(c.r, c.g, c.b, c.a), a.surface, x * 16, y);
+        else
+            surf2Dwrite(make_uchar4(kernel::to_byte(c.r), kernel::to_byte(c.g), kernel::to_byte(c.b),
+                                    kernel::to_byte(c.a)),
+                        a.surface, x * 4, y);
+        return;
+    }
+    unsigned char* row = a.out + static_cast<std::size_t>(y) * a.out_pitch;
+    if (a.is_float)
+        reinterpret_cast<float4*>(row)[x] = make_float4(c.r, c.g, c.b, c.a);
+    else
+        reinterpret_cast<unsigned int*>(row)[x] = kernel::pack_rgba8(c);
+}
+
+// One thread sums all lines for PX points of one lattice row.
+template <int K, int PX, Law L>
+__global__ void __launch_bounds__(128) warp_kernel(const __grid_constant__ KernelArgs a,
+                                                   const __grid_constant__ LineTable table) {
+    constexpr int kRec4 = kernel::record_floats(K) / 4;
+    extern __shared__ float4 s_lines[];
+    const float4* src = a.lines != nullptr ? a.lines : table.rec;
+    const int tid = threadIdx.y * blockDim.x + threadIdx.x;
+    const int threads = blockDim.x * blockDim.y;
+    const int i0 = (blockIdx.x * blockDim.x + threadIdx.x) * PX;
+    const int j = blockIdx.y * blockDim.y + threadIdx.y;
+
+    Accum<K, PX> acc;
+    acc.clear();
+    const float x0 = (static_cast<float>(i0) * a.spacing + 0.5f) * a.inv_extent;
+    const float y = (static_cast<float>(j) * a.spacing + 0.5f) * a.inv_extent;
+    const float step = a.spacing * a.inv_extent;
+    for (int base = 0; base < a.n_lines; base += a.chunk_lines) {
+        const int count = min(a.chunk_lines, a.n_lines - base);
+        __syncthreads();
+        for (int t = tid; t < count * kRec4; t += threads) s_lines[t] = src[base * kRec4 + t];
+        __syncthreads();
+        for (int l = 0; l < count; ++l) {
+            float4 r4[kRec4];
+#pragma unroll
+            for (int q = 0; q < kRec4; ++q) r4[q] = s_lines[l * kRec4 + q];
+            kernel::accumulate_line<K, PX, L>(reinterpret_cast<const float*>(r4), x0, y, step, a.b, acc);
+        }
+    }
+    if (j >= a.points_h) return;
+
+    kernel::ImageView keys[K];
+#pragma unroll
+    for (int k = 0; k < K; ++k) keys[k] = {a.key[k], a.key_pitch, a.width, a.height, a.is_float != 0};
+#pragma unroll
+    for (int p = 0; p < PX; ++p) {
+        const int i = i0 + p;
+        if (i >= a.points_w) break;
+        float dx[K], dy[K];
+        kernel::displacement(acc, p, a.extent, dx, dy);
+        if (a.out_kind == OutKind::Displacement) {
+            float2* d = a.disp + (static_cast<std::size_t>(j) * a.points_w + i) * K;
+#pragma unroll
+            for (int k = 0; k < K; ++k) d[k] = make_float2(dx[k], dy[k]);
+            continue;
+        }
+        const kernel::Rgba c = kernel::blend_sources<K>(keys, a.weight, static_cast<float>(i) + 0.5f,
+                                                        static_cast<float>(j) + 0.5f, dx, dy, a.normal_map != 0);
+        store_pixel(a, i, j, c);
+    }
+}
+
+// Fast mode, pass 2: four pixels of one row a thread, all in one grid cell
+// (fast_cell is a multiple of 4): interpolate the cell's two columns in y
+// once, then along x; sample through the texture unit.
+template <int K>
+__global__ void __launch_bounds__(256) apply_kernel(const __grid_constant__ KernelArgs a) {
+    const int x0 = (blockIdx.x * blockDim.x + threadIdx.x) * 4;
+    const int y = blockIdx.y * blockDim.y + threadIdx.y;
+    if (x0 >= a.width || y >= a.height) return;
+    const int gx = x0 / a.cell, gy = y / a.cell;
+    const float inv_cell = 1.0f / static_cast<float>(a.cell);
+    const float fy = static_cast<float>(y - gy * a.cell) * inv_cell;
+    const float2* top = a.grid + (static_cast<std::size_t>(gy) * a.grid_w + gx) * K;
+    const float2* bottom = top + static_cast<std::size_t>(a.grid_w) * K;
+    float lx[K], ly[K], rx[K], ry[K];
+#pragma unroll
+    for (int k = 0; k < K; ++k) {
+        const float2 t0 = top[k], t1 = top[K + k], b0 = bottom[k], b1 = bottom[K + k];
+        lx[k] = t0.x + fy * (b0.x - t0.x);
+        ly[k] = t0.y + fy * (b0.y - t0.y);
+        rx[k] = t1.x + fy * (b1.x - t1.x);
+        ry[k] = t1.y + fy * (b1.y - t1.y);
+    }
+    const float unit = a.is_float ? 1.0f : 255.0f;
+    unsigned int packed[4];
+    float4 colours[4];
+#pragma unroll
+    for (int p = 0; p < 4; ++p) {
+        const int x = x0 + p;
+        const float fx = static_cast<float>(x - gx * a.cell) * inv_cell;
+        float dx[K], dy[K];
+#pragma unroll
+        for (int k = 0; k < K; ++k) {
+            dx[k] = lx[k] + fx * (rx[k] - lx[k]);
+            dy[k] = ly[k] + fx * (ry[k] - ly[k]);
+        }
+        if (a.out_kind == OutKind::Displacement) {
+            if (x < a.width) {
+                float2* d = a.disp + (static_cast<std::size_t>(y) * a.width + x) * K;
+#pragma unroll
+                for (int k = 0; k < K; ++k) d[k] = make_float2(dx[k], dy[k]);
+            }
+            continue;
+        }
+        const float px = static_cast<float>(x) + 0.5f, py = static_cast<float>(y) + 0.5f;
+        kernel::Rgba sum{0.0f, 0.0f, 0.0f, 0.0f};
+#pragma unroll
+        for (int k = 0; k < K; ++k) {
+            const float4 t = tex2D<float4>(a.tex[k], px + dx[k], py + dy[k]);
+            kernel::add_weighted(sum, {t.x, t.y, t.z, t.w}, a.weight[k] * unit);
+        }
+        if (a.normal_map) sum = kernel::renormalise(sum, unit);
+        colours[p] = make_float4(sum.r, sum.g, sum.b, sum.a);
+        packed[p] = kernel::pack_rgba8(sum);
+    }
+    if (a.out_kind == OutKind::Displacement) return;
+    if (a.out_vector && a.out_kind == OutKind::Pixels && !a.is_float && x0 + 3 < a.width) {
+        unsigned char* row = a.out + static_cast<std::size_t>(y) * a.out_pitch;
+        reinterpret_cast<uint4*>(row)[x0 / 4] = make_uint4(packed[0], packed[1], packed[2], packed[3]);
+        return;
+    }
+#pragma unroll
+    for (int p = 0; p < 4; ++p)
+        if (x0 + p < a.width)
+            store_pixel(a, x0 + p, y, {colours[p].x, colours[p].y, colours[p].z, colours[p].w});
+}
+
+// ---- run-time choices -> templates -----------------------------------------
+
+template <int K, int PX, Law L>
+void launch_warp(dim3 grid, dim3 block, std::size_t smem, cudaStream_t s, const KernelArgs& a, const LineTable& t) {
+    warp_kernel<K, PX, L><<<grid, block, smem, s>>>(a, t);
+}
+
+template <int K>
+void launch_warp_k(int px, Law law, dim3 grid, dim3 block, std::size_t smem, cudaStream_t s, const KernelArgs& a,
+                   const LineTable& t) {
+    const bool sq = law == Law::InverseSquare;
+    if constexpr (K <= 3) {
+        if (px == 8) {
+            sq ? launch_warp<K, 8, Law::InverseSquare>(grid, block, smem, s, a, t)
+               : launch_warp<K, 8, Law::Power>(grid, block, smem, s, a, t);
+            return;
+        }
+    }
+    if (px >= 4)
+        sq ? launch_warp<K, 4, Law::InverseSquare>(grid, block, smem, s, a, t)
+           : launch_warp<K, 4, Law::Power>(grid, block, smem, s, a, t);
+    else
+        sq ? launch_warp<K, 1, Law::InverseSquare>(grid, block, smem, s, a, t)
+           : launch_warp<K, 1, Law::Power>(grid, block, smem, s, a, t);
+}
+
+void launch_warp_any(int k, int px, Law law, dim3 grid, dim3 block, std::size_t smem, cudaStream_t s,
+                     const KernelArgs& a, const LineTable& t) {
+    switch (k) {
+        case 1: launch_warp_k<1>(px, law, grid, block, smem, s, a, t); break;
+        case 2: launch_warp_k<2>(px, law, grid, block, smem, s, a, t); break;
+        case 3: launch_warp_k<3>(px, law, grid, block, smem, s, a, t); break;
+        case 4: launch_warp_k<4>(px, law, grid, block, smem, s, a, t); break;
+        case 5: launch_warp_k<5>(px, law, grid, block, smem, s, a, t); break;
+        case 6: launch_warp_k<6>(px, law, grid, block, smem, s, a, t); break;
+        case 7: launch_warp_k<7>(px, law, grid, block, smem, s, a, t); break;
+        default: launch_warp_k<8>(px, law, grid, block, smem, s, a, t); break;
+    }
+}
+
+void launch_apply_any(int k, dim3 grid, dim3 block, cudaStream_t s, const KernelArgs& a) {
+    switch (k) {
+        case 1: apply_kernel<1><<<grid, block, 0, s>>>(a); break;
+        case 2: apply_kernel<2><<<grid, block, 0, s>>>(a); break;
+        case 3: apply_kernel<3><<<grid, block, 0, s>>>(a); break;
+        case 4: apply_kernel<4><<<grid, block, 0, s>>>(a); break;
+        case 5: apply_kernel<5><<<grid, block, 0, s>>>(a); break;
+        case 6: apply_kernel<6><<<grid, block, 0, s>>>(a); break;
+        case 7: apply_kernel<7><<<grid, block, 0, s>>>(a); break;
+        default: apply_kernel<8><<<grid, block, 0, s>>>(a); break;
+    }
+}
+
+// ---- the backend -------------------------------------------------------------
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+template <class T>
+void device_free(T*& p) {
+    if (p != nullptr) cudaFree(p);
+    p = nullptr;
+}
+
+class CudaBackend final : public BackendImpl {
+public:
+    CudaBackend(int width, int height, PixelFormat format, const std::vector<KeyMap>& keys)
+        : width_(width), height_(height), is_float_(format == PixelFormat::RgbaF32),
+          pixel_bytes_(is_float_ ? 16 : 4) {
+        try {
+            setup(keys);
+        } catch (...) {
+            release();
+            throw;
+        }
+    }
+    ~CudaBackend() override { release(); }
+
+    SetupTimes setup_times() const override { return times_; }
+    void* stream() const override { return stream_; }
+    void synchronize() override { EMOFACE_CUDA_CHECK(cudaStreamSynchronize(stream_)); }
+
+    void run(const FramePlan& plan, const OutputTarget& target) override {
+        EMOFACE_CUDA_CHECK(cudaSetDevice(device_));
+        KernelArgs a{};
+        a.n_lines = plan.lines;
+        a.extent = plan.extent;
+        a.inv_extent = plan.inv_extent;
+        a.b = plan.b;
+        a.width = width_;
+        a.height = height_;
+        a.key_pitch = key_pitch_;
+        a.is_float = is_float_ ? 1 : 0;
+        a.normal_map = plan.normal_map ? 1 : 0;
+        for (int i = 0; i < plan.sources; ++i) {
+            a.key[i] = keys_[plan.source_index[i]];
+            a.tex[i] = textures_[plan.source_index[i]];
+            a.weight[i] = plan.weight[i];
+        }
+
+        // The line table: by value when it fits, else one copy to the device.
+        const std::size_t table_floats = static_cast<std::size_t>(plan.lines) * plan.record_floats;
+        if (table_floats <= 4 * kParamTableFloat4) {
+            std::memcpy(table_.rec, plan.records, table_floats * sizeof(float));
+            a.lines = nullptr;
+        } else {
+            EMOFACE_CUDA_CHECK(cudaEventSynchronize(staged_));  // the last copy has read the staging buffer
+            std::memcpy(staging_, plan.records, table_floats * sizeof(float));
+            EMOFACE_CUDA_CHECK(cudaMemcpyAsync(lines_, staging_, table_floats * sizeof(float),
+                                               cudaMemcpyHostToDevice, stream_));
+            EMOFACE_CUDA_CHECK(cudaEventRecord(staged_, stream_));
+            a.lines = lines_;
+        }
+        const int rec4 = plan.record_floats / 4;
+        a.chunk_lines = std::max(1, std::min(plan.lines, kSharedTableBytes / (rec4 * 16)));
+        const std::size_t smem = plan.lines > 0 ? static_cast<std::size_t>(a.chunk_lines) * rec4 * 16 : 0;
+
+        // Where the pixels go.
+        const bool positions = target.kind == OutputTarget::Kind::Positions;
+        const bool to_host = target.kind == OutputTarget::Kind::Host;
+        if (positions) {
+            ensure(disp_, disp_bytes_, static_cast<std::size_t>(width_) * height_ * plan.sources * sizeof(float2));
+            a.out_kind = OutKind::Displacement;
+            a.disp = disp_;
+        } else if (target.kind == OutputTarget::Kind::Surface) {
+            a.out_kind = OutKind::Surface;
+            a.surface = static_cast<cudaSurfaceObject_t>(target.surface);
+        } else {
+            a.out_kind = OutKind::Pixels;
+            if (to_host) {
+                ensure(out_, out_bytes_, static_cast<std::size_t>(width_) * height_ * pixel_bytes_);
+                a.out = out_;
+                a.out_pitch = static_cast<std::size_t>(width_) * pixel_bytes_;
+            } else {
+                a.out = static_cast<unsigned char*>(target.ptr);
+                a.out_pitch = target.pitch;
+            }
+            a.out_vector = (reinterpret_cast<std::uintptr_t>(a.out) % 16 == 0 && a.out_pitch % 16 == 0) ? 1 : 0;
+        }
+
+        const dim3 warp_block(32, 4);
+        if (plan.accuracy == Accuracy::Exact) {
+            a.points_w = width_;
+            a.points_h = height_;
+            a.spacing = 1.0f;
+            launch_points(plan, a, smem, warp_block);
+        } else {
+            const int cell = plan.fast_cell;
+            a.cell = cell;
+            a.grid_w = (width_ - 1) / cell + 2;
+            const int grid_h = (height_ - 1) / cell + 2;
+            ensure(grid_, grid_bytes_, static_cast<std::size_t>(a.grid_w) * grid_h * plan.sources * sizeof(float2));
+            KernelArgs g = a;
+            g.points_w = a.grid_w;
+            g.points_h = grid_h;
+            g.spacing = static_cast<float>(cell);
+            g.out_kind = OutKind::Displacement;
+            g.disp = grid_;
+            launch_points(plan, g, smem, warp_block);
+            a.grid = grid_;
+            const dim3 block(32, 8);
+            const dim3 blocks((width_ + 4 * 32 - 1) / (4 * 32), (height_ + 7) / 8);
+            launch_apply_any(plan.sources, blocks, block, stream_, a);
+            EMOFACE_CUDA_CHECK(cudaGetLastError());
+        }
+
+        if (to_host) {
+            EMOFACE_CUDA_CHECK(cudaMemcpy2DAsync(target.ptr, target.pitch, out_,
+                                                 static_cast<std::size_t>(width_) * pixel_bytes_,
+                                                 static_cast<std::size_t>(width_) * pixel_bytes_, height_,
+                                                 cudaMemcpyDeviceToHost, stream_));
+            synchronize();
+        } else if (positions) {
+            auto* out = static_cast<float*>(target.ptr);
+            const std::size_t floats = static_cast<std::size_t>(width_) * height_ * plan.sources * 2;
+            EMOFACE_CUDA_CHECK(
+                cudaMemcpyAsync(out, disp_, floats * sizeof(float), cudaMemcpyDeviceToHost, stream_));
+            synchronize();
+            for (int y = 0; y < height_; ++y)
+                for (int x = 0; x < width_; ++x) {
+                    float* p = out + (static_cast<std::size_t>(y) * width_ + x) * plan.sources * 2;
+                    for (int k = 0; k < plan.sources; ++k) {
+                        p[2 * k] += static_cast<float>(x) + 0.5f;
+                        p[2 * k + 1] += static_cast<float>(y) + 0.5f;
+                    }
+                }
+        }
+    }
+
+private:
+    // Shared memory for staged lines per block: 32 KB leaves room for several
+    // blocks per multiprocessor.
+    static constexpr int kSharedTableBytes = 32 * 1024;
+
+    void launch_points(const FramePlan& plan, const KernelArgs& a, std::size_t smem, dim3 block) {
+        // Several points a thread amortise the line loads (8 where the sums
+        // of up to 3 sources leave registers to spare, else 4); on small
+        // lattices that would leave the GPU too few threads, so take one.
+        const long long points = static_cast<long long>(a.points_w) * a.points_h;
+        int px = 1;
+        if (points >= (1 << 18)) px = 4;
+        if (points >= (1 << 21) && plan.sources <= 3) px = 8;
+        if (px_override_ > 0) px = px_override_;
+        const dim3 blocks((a.points_w + px * block.x - 1) / (px * block.x), (a.points_h + block.y - 1) / block.y);
+        launch_warp_any(plan.sources, px, plan.law, blocks, block, smem, stream_, a, table_);
+        EMOFACE_CUDA_CHECK(cudaGetLastError());
+    }
+
+    template <class T>
+    void ensure(T*& p, std::size_t& capacity, std::size_t bytes) {
+        if (bytes <= capacity) return;
+        EMOFACE_CUDA_CHECK(cudaStreamSynchronize(stream_));
+        device_free(p);
+        capacity = 0;
+        EMOFACE_CUDA_CHECK(cudaMalloc(reinterpret_cast<void**>(&p), bytes));
+        capacity = bytes;
+    }
+
+    void setup(const std::vector<KeyMap>& keys) {
+        if (const char* px = std::getenv("EMOFACE_MORPH_PX")) {
+            const int v = std::atoi(px);
+            if (v == 1 || v == 4 || (v == 8 && keys.size() <= 3)) px_override_ = v;
+        }
+        EMOFACE_CUDA_CHECK(cudaGetDevice(&device_));
+        EMOFACE_CUDA_CHECK(cudaFree(nullptr));  // context creation is not allocation
+        auto t0 = Clock::now();
+        EMOFACE_CUDA_CHECK(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking));
+        EMOFACE_CUDA_CHECK(cudaEventCreateWithFlags(&staged_, cudaEventDisableTiming));
+        const std::size_t row = static_cast<std::size_t>(width_) * pixel_bytes_;
+        keys_.assign(keys.size(), nullptr);
+        textures_.assign(keys.size(), 0);
+        for (std::size_t k = 0; k < keys.size(); ++k) {
+            void* p = nullptr;
+            EMOFACE_CUDA_CHECK(cudaMallocPitch(&p, &key_pitch_, row, height_));
+            keys_[k] = static_cast<unsigned char*>(p);
+        }
+        // The device line table, for tables that do not fit the parameter.
+        const std::size_t table_floats =
+            static_cast<std::size_t>(keys[0].layout.size()) * kernel::record_floats(static_cast<int>(keys.size()));
+        if (table_floats > 4 * kParamTableFloat4) {
+            EMOFACE_CUDA_CHECK(cudaMalloc(reinterpret_cast<void**>(&lines_), table_floats * sizeof(float)));
+            EMOFACE_CUDA_CHECK(cudaMallocHost(reinterpret_cast<void**>(&staging_), table_floats * sizeof(float)));
+        }
+        for (std::size_t k = 0; k < keys.size(); ++k) {
+            cudaResourceDesc res{};
+            res.resType = cudaResourceTypePitch2D;
+            res.res.pitch2D.devPtr = keys_[k];
+            res.res.pitch2D.desc =
+                is_float_ ? cudaCreateChannelDesc<float4>() : cudaCreateChannelDesc<uchar4>();
+            res.res.pitch2D.width = width_;
+            res.res.pitch2D.height = height_;
+            res.res.pitch2D.pitchInBytes = key_pitch_;
+            cudaTextureDesc tex{};
+            tex.addressMode[0] = cudaAddressModeClamp;
+            tex.addressMode[1] = cudaAddressModeClamp;
+            tex.filterMode = cudaFilterModeLinear;
+            tex.readMode = is_float_ ? cudaReadModeElementType : cudaReadModeNormalizedFloat;
+            tex.normalizedCoords = 0;
+            EMOFACE_CUDA_CHECK(cudaCreateTextureObject(&textures_[k], &res, &tex, nullptr));
+        }
+        EMOFACE_CUDA_CHECK(cudaDeviceSynchronize());
+        times_.allocate_ms = ms_since(t0);
+
+        t0 = Clock::now();
+        for (std::size_t k = 0; k < keys.size(); ++k)
+            EMOFACE_CUDA_CHECK(cudaMemcpy2DAsync(keys_[k], key_pitch_, keys[k].pixels, row, row, height_,
+                                                 cudaMemcpyHostToDevice, stream_));
+        EMOFACE_CUDA_CHECK(cudaStreamSynchronize(stream_));
+        times_.upload_ms = ms_since(t0);
+    }
+
+    void release() noexcept {
+        if (stream_ != nullptr) cudaStreamSynchronize(stream_);
+        for (cudaTextureObject_t t : textures_)
+            if (t != 0) cudaDestroyTextureObject(t);
+        textures_.clear();
+        for (unsigned char*& k : keys_) device_free(k);
+        keys_.clear();
+        device_free(lines_);
+        device_free(grid_);
+        device_free(out_);
+        device_free(disp_);
+        if (staging_ != nullptr) cudaFreeHost(staging_);
+        staging_ = nullptr;
+        if (staged_ != nullptr) cudaEventDestroy(staged_);
+        staged_ = nullptr;
+        if (stream_ != nullptr) cudaStreamDestroy(stream_);
+        stream_ = nullptr;
+    }
+
+    int width_, height_;
+    bool is_float_;
+    std::size_t pixel_bytes_;
+    int px_override_ = 0;  // EMOFACE_MORPH_PX=1|4|8, for the benchmark's sweeps
+    int device_ = 0;
+    cudaStream_t stream_ = nullptr;
+    cudaEvent_t staged_ = nullptr;
+    std::vector<unsigned char*> keys_;
+    std::vector<cudaTextureObject_t> textures_;
+    std::size_t key_pitch_ = 0;
+    float4* lines_ = nullptr;
+    float* staging_ = nullptr;
+    float2* grid_ = nullptr;
+    std::size_t grid_bytes_ = 0;
+    unsigned char* out_ = nullptr;
+    std::size_t out_bytes_ = 0;
+    float2* disp_ = nullptr;
+    std::size_t disp_bytes_ = 0;
+    LineTable table_;  // host copy of the by-value table (8 KB, not on the stack)
+    SetupTimes times_;
+};
+
+struct DeviceStatus {
+    bool usable = false;
+    std::string why;
+    std::string description;
+};
+
+const DeviceStatus& device_status() {
+    static const DeviceStatus status = [] {
+        DeviceStatus s;
+        int count = 0;
+        cudaError_t e = cudaGetDeviceCount(&count);
+        if (e != cudaSuccess) {
+            s.why = std::string("cudaGetDeviceCount: ") + cudaGetErrorString(e);
+            cudaGetLastError();
+            return s;
+        }
+        if (count == 0) {
+            s.why = "no CUDA device found";
+            return s;
+        }
+        int device = 0;
+        cudaGetDevice(&device);
+        cudaDeviceProp prop{};
+        if ((e = cudaGetDeviceProperties(&prop, device)) != cudaSuccess) {
+            s.why = std::string("cudaGetDeviceProperties: ") + cudaGetErrorString(e);
+            return s;
+        }
+        s.description = std::string(prop.name) + " (sm_" + std::to_string(prop.major) + std::to_string(prop.minor) +
+                        ", " + std::to_string(prop.multiProcessorCount) + " SMs)";
+        // A device this binary has no code for (see CMAKE_CUDA_ARCHITECTURES).
+        cudaFuncAttributes attr{};
+        if ((e = cudaFuncGetAttributes(&attr, apply_kernel<1>)) != cudaSuccess) {
+            s.why = s.description + " has no matching kernel image in this build (" + cudaGetErrorString(e) +
+                    "); add its architecture to CMAKE_CUDA_ARCHITECTURES";
+            cudaGetLastError();
+            return s;
+        }
+        s.usable = true;
+        return s;
+    }();
+    return status;
+}
+
+}  // namespace
+
+std::unique_ptr<BackendImpl> make_cuda_backend(int width, int height, PixelFormat format,
+                                               const std::vector<KeyMap>& keys) {
+    return std::make_unique<CudaBackend>(width, height, format, keys);
+}
+
+bool cuda_device_usable(std::string* why) {
+    const DeviceStatus& s = device_status();
+    if (!s.usable && why != nullptr) *why = s.why;
+    return s.usable;
+}
+
+std::string cuda_describe_device() {
+    const DeviceStatus& s = device_status();
+    return s.usable ? s.description : "none (" + s.why + ")";
+}
+
+}  // namespace emoface::morph::detail
