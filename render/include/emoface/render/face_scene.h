@@ -1,0 +1,122 @@
+#pragma once
+// One frame of the pipeline (DESIGN.md, "One frame") on a face:
+//   FAPs -> rig (mesh + feature points) -> target layout L* (feature points
+//   projected into the face's texture box) -> morph of the key wrinkle maps
+//   onto L* into the wrinkle texture (interop on the GPU) -> wrinkle UVs
+//   (every vertex projected the same way) -> tangent frames -> draw.
+// The face's mesh is drawn as three meshes with their own materials: skin
+// (bump-mapped with the wrinkle map), eyeballs (glossy, no wrinkles) and the
+// mouth interior (teeth, tongue, cavity; no wrinkles).
+#include <array>
+#include <bitset>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "emoface/expression/face.h"
+#include "emoface/expression/feature_layout.h"
+#include "emoface/expression/rig.h"
+#include "emoface/expression/wrinkle_map.h"
+#include "emoface/morph/morph.h"
+#include "emoface/render/platform.h"
+#include "emoface/render/renderer.h"
+#include "emoface/render/wrinkle_texture.h"
+
+namespace emoface::render {
+
+// A key of the wrinkle morph: a normal map (RGBA8, rows top first, the
+// convention of expression/wrinkle_map.h) and the layout it was made at.
+struct WrinkleKey {
+    std::string name;
+    expression::NormalMap map;
+    expression::FeatureLayout layout;
+};
+
+// The face-space box of `face` as the layout functions take it.
+expression::TextureBox layout_box(const expression::Face& face);
+
+// The layout of the face posed by `faps`: its feature points projected into
+// the face's texture box.
+expression::FeatureLayout posed_layout(const expression::Face& face,
+                                       const expression::FaceRig& rig,
+                                       const expression::FapValues& faps);
+
+// One key per (key, pose): the library's wrinkles of `key` generated at the
+// layout of the face posed by `pose` (the key expression at full intensity),
+// size x size pixels.
+WrinkleKey make_wrinkle_key(const expression::Face& face, const expression::FaceRig& rig,
+                            const expression::WrinkleLibrarySpec& spec, expression::WrinkleKey key,
+                            const expression::FapValues& pose, int size);
+
+struct FaceSceneOptions {
+    morph::Backend backend = morph::Backend::Auto;
+    // Beier-Neely parameters; normal_map is always set (the keys are normal maps).
+    morph::MorphParams morph{};
+    Material skin{};  // base_texture: the face's base colour unless set
+    Material eyes{};
+    Material mouth{};
+    FaceSceneOptions();
+};
+
+// Wall-clock milliseconds of the stages of the last update() (host side; the
+// GPU morph is only queued, its time shows in the draw or a later sync).
+struct FrameStageTimes {
+    double rig_ms = 0, layout_ms = 0, morph_ms = 0, uv_ms = 0, tangents_ms = 0, upload_ms = 0;
+};
+
+class WrinkleMorph;
+
+class FaceScene {
+public:
+    // `face` and `rig` must outlive the scene. Keys: at most
+    // morph::Morpher::kMaxKeys, all of one size. `lines`: the feature lines of
+    // the morph (lines_for_face() of the face's present points).
+    FaceScene(Platform& platform, const expression::Face& face, const expression::FaceRig& rig,
+              std::vector<WrinkleKey> keys, std::vector<expression::FeatureLine> lines,
+              const FaceSceneOptions& options = {});
+    ~FaceScene();
+    FaceScene(const FaceScene&) = delete;
+    FaceScene& operator=(const FaceScene&) = delete;
+
+    // One frame: the face deformed by `faps`, the keys blended by
+    // `key_weights` (one per key, each >= 0, sum <= 1) onto the frame's layout.
+    void update(const expression::FapValues& faps, const std::vector<float>& key_weights);
+
+    // Draws the three meshes (options.wrinkles false: without the wrinkle map).
+    void draw(const DrawOptions& options);
+
+    // A frontal camera framing the face (neutral pose) for this aspect ratio.
+    Camera frontal_camera(float aspect, float fovy_degrees = 20.0f) const;
+    // A key light above-left of the camera, as a portrait is lit.
+    Light portrait_light() const;
+
+    const FrameStageTimes& last_times() const { return times_; }
+    bool uses_interop() const;
+    int key_count() const;
+    const expression::TriMesh& mesh() const { return mesh_; }
+    const expression::FeatureLayout& layout() const { return layout_; }
+    WrinkleTexture& wrinkle_texture() { return *texture_; }
+    morph::Morpher& morpher() { return *morpher_; }
+    Renderer& renderer() { return *renderer_; }
+
+private:
+    struct Part;
+    Platform& platform_;
+    const expression::Face& face_;
+    const expression::FaceRig& rig_;
+    expression::TextureBox box_;
+    std::vector<expression::FeatureLine> lines_;
+    expression::TriMesh mesh_;  // the posed full mesh
+    expression::DeformedFace deformed_;
+    expression::FeatureLayout layout_;
+    morph::Layout target_;
+    std::vector<Part> parts_;
+    std::unique_ptr<Renderer> renderer_;
+    std::unique_ptr<WrinkleTexture> texture_;
+    std::unique_ptr<morph::Morpher> morpher_;
+    std::unique_ptr<WrinkleMorph> wrinkle_morph_;
+    morph::MorphParams params_;
+    FrameStageTimes times_;
+};
+
+}  // namespace emoface::render

@@ -1,0 +1,273 @@
+#include "emoface/render/face_scene.h"
+
+#include <algorithm>
+#include <chrono>
+#include <limits>
+
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+
+#include "emoface/common/error.h"
+#include "emoface/render/tangents.h"
+#include "emoface/render/wrinkle_morph.h"
+
+namespace emoface::render {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+enum Group { kSkin = 0, kEyes = 1, kMouth = 2, kGroups = 3 };
+
+Group group_of(expression::VertexPart p) {
+    switch (p) {
+        case expression::VertexPart::Skin: return kSkin;
+        case expression::VertexPart::EyeballLeft:
+        case expression::VertexPart::EyeballRight: return kEyes;
+        default: return kMouth;
+    }
+}
+
+std::bitset<expression::kFeatureCount> present_points(const expression::Face& face) {
+    std::bitset<expression::kFeatureCount> present;
+    for (int i = 0; i < expression::kFeatureCount; ++i) present[i] = face.feature_points[i].present;
+    return present;
+}
+
+expression::FeatureLayout layout_of(const fap::FeaturePointPositions& positions,
+                                    const std::bitset<expression::kFeatureCount>& present,
+                                    const expression::TextureBox& box) {
+    std::array<glm::vec3, expression::kFeatureCount> p{};
+    for (int i = 0; i < expression::kFeatureCount; ++i)
+        p[i] = glm::vec3(float(positions[i][0]), float(positions[i][1]), float(positions[i][2]));
+    return expression::projective_layout(p, present, box);
+}
+
+morph::Layout to_morph_layout(const std::vector<expression::Segment>& segments) {
+    morph::Layout out;
+    out.reserve(segments.size());
+    for (const auto& s : segments) out.push_back({s.p.x, s.p.y, s.q.x, s.q.y});
+    return out;
+}
+
+}  // namespace
+
+expression::TextureBox layout_box(const expression::Face& face) {
+    const expression::TextureBox& box = face.texture_box;
+    if (!(box.max.x > box.min.x) || !(box.max.y > box.min.y))
+        fail<InputError>("render: face '{}' has an empty texture box ({}, {})-({}, {})", face.name,
+                         box.min.x, box.min.y, box.max.x, box.max.y);
+    return box;
+}
+
+expression::FeatureLayout posed_layout(const expression::Face& face,
+                                       const expression::FaceRig& rig,
+                                       const expression::FapValues& faps) {
+    return layout_of(rig.feature_points(faps), present_points(face), layout_box(face));
+}
+
+WrinkleKey make_wrinkle_key(const expression::Face& face, const expression::FaceRig& rig,
+                            const expression::WrinkleLibrarySpec& spec, expression::WrinkleKey key,
+                            const expression::FapValues& pose, int size) {
+    WrinkleKey k;
+    k.name = expression::wrinkle_key_name(key);
+    k.layout = posed_layout(face, rig, pose);
+    k.map = expression::generate_wrinkle_map(spec, key, k.layout, size);
+    return k;
+}
+
+FaceSceneOptions::FaceSceneOptions() {
+    morph.normal_map = true;
+    skin.shininess = 20.0f;
+    skin.specular_color = glm::vec3(0.35f);
+    eyes.uses_wrinkle_map = false;
+    eyes.shininess = 90.0f;
+    eyes.specular_color = glm::vec3(1.0f);
+    mouth.uses_wrinkle_map = false;
+    mouth.shininess = 12.0f;
+    mouth.specular_color = glm::vec3(0.1f);
+}
+
+struct FaceScene::Part {
+    expression::TriMesh mesh;
+    std::vector<int> full_index;  // part vertex -> full mesh vertex
+    std::vector<glm::vec2> wrinkle_uvs;
+    std::vector<glm::vec4> fixed_tangents;  // parts without wrinkles
+    TangentFrames frames;
+    Renderer::MeshId id = -1;
+    bool wrinkles = false;
+};
+
+FaceScene::FaceScene(Platform& platform, const expression::Face& face,
+                     const expression::FaceRig& rig, std::vector<WrinkleKey> keys,
+                     std::vector<expression::FeatureLine> lines, const FaceSceneOptions& options)
+    : platform_(platform), face_(face), rig_(rig), box_(layout_box(face)), lines_(std::move(lines)),
+      params_(options.morph) {
+    params_.normal_map = true;
+    if (keys.empty()) fail<InputError>("render: FaceScene: no wrinkle keys");
+    if (lines_.empty()) fail<InputError>("render: FaceScene: no feature lines");
+    if (face.parts.size() != face.mesh.n_vertices())
+        fail<InputError>("render: FaceScene: face '{}' has {} vertex parts for {} vertices",
+                         face.name, face.parts.size(), face.mesh.n_vertices());
+    const int size_w = keys[0].map.width, size_h = keys[0].map.height;
+
+    // The morph: every key with its layout's lines.
+    std::vector<morph::KeyMap> maps;
+    for (const WrinkleKey& k : keys) {
+        if (k.map.width != size_w || k.map.height != size_h)
+            fail<InputError>("render: FaceScene: key '{}' is {}x{}, key '{}' {}x{}", k.name,
+                             k.map.width, k.map.height, keys[0].name, size_w, size_h);
+        maps.push_back({k.map.rgba.data(),
+                        to_morph_layout(expression::layout_segments(lines_, k.layout)), size_w,
+                        size_h});
+    }
+    morpher_ = std::make_unique<morph::Morpher>(size_w, size_h, morph::PixelFormat::Rgba8,
+                                                std::move(maps), options.backend);
+
+    platform_.make_current();
+    texture_ = std::make_unique<WrinkleTexture>(size_w, size_h, TexelFormat::RGBA8,
+                                                NormalEncoding::Unsigned);
+    wrinkle_morph_ = std::make_unique<WrinkleMorph>(*morpher_, *texture_);
+    renderer_ = std::make_unique<Renderer>(platform_);
+
+    // Split the mesh by part. A triangle touching an eyeball vertex belongs
+    // to the eyes, else one touching the mouth interior to the mouth.
+    mesh_ = face.mesh;
+    if (!mesh_.has_vertex_normals()) mesh_.request_vertex_normals();
+    if (!mesh_.has_face_normals()) mesh_.request_face_normals();
+    mesh_.update_normals();
+    parts_.resize(kGroups);
+    std::vector<std::vector<int>> local(kGroups, std::vector<int>(mesh_.n_vertices(), -1));
+    for (const auto fh : mesh_.faces()) {
+        int v[3], k = 0;
+        for (const auto vh : mesh_.fv_range(fh))
+            if (k < 3) v[k++] = vh.idx();
+        if (k != 3) continue;
+        Group g = kSkin;
+        for (int i = 0; i < 3; ++i) {
+            const Group gi = group_of(face.parts[std::size_t(v[i])]);
+            if (gi == kEyes || (gi == kMouth && g == kSkin)) g = gi;
+        }
+        Part& part = parts_[g];
+        expression::TriMesh::VertexHandle h[3];
+        for (int i = 0; i < 3; ++i) {
+            int& l = local[g][std::size_t(v[i])];
+            if (l < 0) {
+                l = int(part.full_index.size());
+                part.full_index.push_back(v[i]);
+                part.mesh.add_vertex(mesh_.point(mesh_.vertex_handle(v[i])));
+            }
+            h[i] = part.mesh.vertex_handle(l);
+        }
+        part.mesh.add_face(h[0], h[1], h[2]);
+    }
+    const Material* materials[kGroups] = {&options.skin, &options.eyes, &options.mouth};
+    for (int g = 0; g < kGroups; ++g) {
+        Part& part = parts_[g];
+        if (part.mesh.n_faces() == 0) continue;
+        part.mesh.request_vertex_normals();
+        part.mesh.request_vertex_texcoords2D();
+        for (std::size_t i = 0; i < part.full_index.size(); ++i) {
+            const auto full = mesh_.vertex_handle(part.full_index[i]);
+            const auto vh = part.mesh.vertex_handle(int(i));
+            part.mesh.set_normal(vh, mesh_.normal(full));
+            if (mesh_.has_vertex_texcoords2D()) part.mesh.set_texcoord2D(vh, mesh_.texcoord2D(full));
+        }
+        Material m = *materials[g];
+        if (!m.base_texture && !face.base_colour.empty()) {
+            auto img = std::make_shared<ImageRGBA8>(face.base_colour.width, face.base_colour.height);
+            img->pixels = face.base_colour.rgba;
+            m.base_texture = std::move(img);
+        }
+        part.wrinkles = m.uses_wrinkle_map;
+        part.wrinkle_uvs.assign(part.full_index.size(), glm::vec2(0.0f));
+        if (!part.wrinkles) part.fixed_tangents.assign(part.full_index.size(), glm::vec4(1, 0, 0, 1));
+        part.id = renderer_->add_mesh(part.mesh, m);
+    }
+
+    // Start at the neutral pose with the first key alone.
+    expression::FapValues neutral{};
+    std::vector<float> weights(keys.size(), 0.0f);
+    weights[0] = 1.0f;
+    update(neutral, weights);
+}
+
+FaceScene::~FaceScene() {
+    platform_.make_current();
+    wrinkle_morph_.reset();
+    texture_.reset();
+    renderer_.reset();
+}
+
+bool FaceScene::uses_interop() const { return wrinkle_morph_->uses_interop(); }
+int FaceScene::key_count() const { return morpher_->keys(); }
+
+void FaceScene::update(const expression::FapValues& faps, const std::vector<float>& key_weights) {
+    platform_.make_current();
+    auto t = Clock::now();
+    rig_.deform(faps, deformed_);
+    expression::FaceRig::write_to(deformed_, mesh_);
+    times_.rig_ms = ms_since(t);
+
+    t = Clock::now();
+    layout_ = layout_of(deformed_.feature_points, present_points(face_), box_);
+    target_ = to_morph_layout(expression::layout_segments(lines_, layout_));
+    times_.layout_ms = ms_since(t);
+
+    t = Clock::now();
+    wrinkle_morph_->update(target_, key_weights, params_);
+    times_.morph_ms = ms_since(t);
+
+    times_.uv_ms = times_.tangents_ms = times_.upload_ms = 0.0;
+    for (Part& part : parts_) {
+        if (part.id < 0) continue;
+        t = Clock::now();
+        for (std::size_t i = 0; i < part.full_index.size(); ++i) {
+            const auto full = mesh_.vertex_handle(part.full_index[i]);
+            const auto vh = part.mesh.vertex_handle(int(i));
+            const auto& p = mesh_.point(full);
+            part.mesh.set_point(vh, p);
+            part.mesh.set_normal(vh, mesh_.normal(full));
+            if (part.wrinkles)
+                part.wrinkle_uvs[i] = expression::project_to_texture(glm::vec3(p[0], p[1], p[2]), box_);
+        }
+        times_.uv_ms += ms_since(t);
+        t = Clock::now();
+        if (part.wrinkles) part.frames.compute(part.mesh, part.wrinkle_uvs);
+        times_.tangents_ms += ms_since(t);
+        t = Clock::now();
+        renderer_->update_mesh(part.id, part.mesh, part.wrinkle_uvs,
+                               part.wrinkles ? part.frames.tangents() : part.fixed_tangents);
+        times_.upload_ms += ms_since(t);
+    }
+}
+
+void FaceScene::draw(const DrawOptions& options) {
+    renderer_->draw(options, texture_.get());
+}
+
+Camera FaceScene::frontal_camera(float aspect, float fovy_degrees) const {
+    glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+    for (const auto vh : face_.mesh.vertices()) {
+        const auto& p = face_.mesh.point(vh);
+        lo = glm::min(lo, glm::vec3(p[0], p[1], p[2]));
+        hi = glm::max(hi, glm::vec3(p[0], p[1], p[2]));
+    }
+    return Camera::frontal(lo, hi, aspect, fovy_degrees, 0.92f);
+}
+
+Light FaceScene::portrait_light() const {
+    Light l;
+    // From above and to the viewer's left: grazing enough on the forehead
+    // and around the eyes that horizontal and vertical wrinkles both shade.
+    l.position = glm::vec4(glm::normalize(glm::vec3(-0.35f, 0.55f, 0.75f)), 0.0f);
+    l.ambient = glm::vec3(0.16f);
+    l.diffuse = glm::vec3(0.95f, 0.93f, 0.9f);
+    l.specular = glm::vec3(0.3f);
+    return l;
+}
+
+}  // namespace emoface::render

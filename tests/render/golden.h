@@ -1,0 +1,37 @@
+#pragma once
+// Golden-image comparison in the way Filament's imagediff does it: explicit
+// tolerances, each with a written reason, and on a mismatch the actual image
+// and an amplified difference image are written for a person to look at.
+// With EMOFACE_UPDATE_GOLDENS=1 in the environment (scripts/update-goldens)
+// the goldens are rewritten instead of compared.
+#include <string>
+
+#include "emoface/render/image.h"
+
+namespace emoface::render::testing {
+
+struct Tolerance {
+    int max_channel_diff;   // largest |actual - golden| of any RGB channel, 0..255
+    double mean_diff;       // mean |actual - golden| over all RGB channels
+    const char* reason;     // why these numbers (printed with a failure)
+};
+
+struct GoldenResult {
+    bool ok = false;
+    bool updated = false;  // EMOFACE_UPDATE_GOLDENS: the golden was written
+    int max_channel_diff = 0;
+    double mean_diff = 0.0;
+    std::string message;   // what failed and where the actual/diff images are
+};
+
+// Compares `actual` with the PNG `golden_path`. On a mismatch (or a missing
+// golden) writes <failure_dir>/<name>.actual.png and <name>.diff.png.
+GoldenResult compare_with_golden(const ImageRGBA8& actual, const std::string& golden_path,
+                                 const Tolerance& tolerance, const std::string& failure_dir);
+
+// A box-filtered 2x reduction (even sizes): goldens are stored at half the
+// rendered size, which keeps them small and averages away single-sample
+// edge differences.
+ImageRGBA8 downsample2x(const ImageRGBA8& image);
+
+}  // namespace emoface::render::testing
