@@ -8,9 +8,10 @@
 //   exact: warp_kernel over the pixels: lines staged in shared memory, u, v
 //          and the weight once per pixel-line for all sources, hand bilinear
 //          sampling (bit-compatible with the CPU), blend, store.
-//   fast:  warp_kernel over a grid every `fast_cell` pixels writing
-//          displacements, then apply_kernel over the pixels: bilinear
-//          interpolation of the grid and texture-unit sampling.
+//   fast:  warp_kernel over a grid every `fast_cell` pixels writing the
+//          sums of all lines, near_kernel listing each cell's near lines,
+//          then apply_kernel over the pixels: far sums interpolated, near
+//          lines exact (kernel.h, "fast mode"), texture-unit sampling.
 // Nothing is allocated per frame; buffers for positions, host output and the
 // fast grid are allocated at their first use.
 #include <cuda_runtime.h>
@@ -46,12 +47,14 @@ struct LineTable {
     float4 rec[kParamTableFloat4];
 };
 
-enum class OutKind : int { Pixels, Surface, Displacement };
+enum class OutKind : int { Pixels, Surface, Displacement, Sums };
 
 struct KernelArgs {
     const float4* lines;  // device table, or nullptr: the LineTable parameter
     int n_lines;
+    int record_floats;
     int chunk_lines;  // lines staged in shared memory at a time
+    int line_split;   // PX = 1 only: threadIdx.y splits the lines of one row, not rows
     float extent, inv_extent, b;
     int points_w, points_h;  // the lattice evaluated by warp_kernel
     float spacing;           // pixels between lattice points
@@ -68,8 +71,13 @@ struct KernelArgs {
     int out_vector;  // out and out_pitch allow 16-byte stores
     cudaSurfaceObject_t surface;
     float2* disp;  // Displacement: [point][source] in pixels
-    const float2* grid;
-    int grid_w, cell;
+    float* sums;   // Sums: [point][kernel::sum_floats(K)]
+    // Fast mode: grid sums, and per cell its near lines.
+    const float* grid;
+    int grid_w, cell, tiles_w, tiles_h;
+    float reach;  // iso units, from a cell's centre
+    int* near_count;
+    unsigned short* near_list;  // [cell][kernel::kMaxNear]
 };
 
 __device__ __forceinline__ void store_pixel(const KernelArgs& a, int x, int y, const kernel::Rgba& c) {
@@ -89,17 +97,24 @@ __device__ __forceinline__ void store_pixel(const KernelArgs& a, int x, int y, c
         reinterpret_cast<unsigned int*>(row)[x] = kernel::pack_rgba8(c);
 }
 
-// One thread sums all lines for PX points of one lattice row.
+// One thread sums all lines for PX points of one lattice row. On small
+// lattices (line_split > 1, PX = 1) the threadIdx.y threads of a block share
+// one row instead: each sums every line_split-th line and the partial sums
+// meet in shared memory, so a 256² image still fills the GPU.
 template <int K, int PX, Law L>
 __global__ void __launch_bounds__(128) warp_kernel(const __grid_constant__ KernelArgs a,
                                                    const __grid_constant__ LineTable table) {
     constexpr int kRec4 = kernel::record_floats(K) / 4;
+    constexpr int S = kernel::sum_floats(K);
     extern __shared__ float4 s_lines[];
     const float4* src = a.lines != nullptr ? a.lines : table.rec;
     const int tid = threadIdx.y * blockDim.x + threadIdx.x;
     const int threads = blockDim.x * blockDim.y;
+    const bool split = PX == 1 && a.line_split > 1;
     const int i0 = (blockIdx.x * blockDim.x + threadIdx.x) * PX;
-    const int j = blockIdx.y * blockDim.y + threadIdx.y;
+    const int j = split ? blockIdx.y : blockIdx.y * blockDim.y + threadIdx.y;
+    const int first_line = split ? threadIdx.y : 0;
+    const int line_step = split ? blockDim.y : 1;
 
     Accum<K, PX> acc;
     acc.clear();
@@ -111,11 +126,35 @@ __global__ void __launch_bounds__(128) warp_kernel(const __grid_constant__ Kerne
         __syncthreads();
         for (int t = tid; t < count * kRec4; t += threads) s_lines[t] = src[base * kRec4 + t];
         __syncthreads();
-        for (int l = 0; l < count; ++l) {
+        for (int l = first_line; l < count; l += line_step) {
             float4 r4[kRec4];
 #pragma unroll
             for (int q = 0; q < kRec4; ++q) r4[q] = s_lines[l * kRec4 + q];
             kernel::accumulate_line<K, PX, L>(reinterpret_cast<const float*>(r4), x0, y, step, a.b, acc);
+        }
+    }
+    if constexpr (PX == 1) {
+        if (split) {
+            float* partial = reinterpret_cast<float*>(s_lines + a.chunk_lines * kRec4);
+            __syncthreads();
+            float* mine = partial + (threadIdx.y * blockDim.x + threadIdx.x) * S;
+            mine[0] = acc.w[0];
+#pragma unroll
+            for (int k = 0; k < K; ++k) {
+                mine[1 + 2 * k] = acc.dx[k][0];
+                mine[2 + 2 * k] = acc.dy[k][0];
+            }
+            __syncthreads();
+            if (threadIdx.y != 0) return;
+            for (int g = 1; g < static_cast<int>(blockDim.y); ++g) {
+                const float* other = partial + (g * blockDim.x + threadIdx.x) * S;
+                acc.w[0] += other[0];
+#pragma unroll
+                for (int k = 0; k < K; ++k) {
+                    acc.dx[k][0] += other[1 + 2 * k];
+                    acc.dy[k][0] += other[2 + 2 * k];
+                }
+            }
         }
     }
     if (j >= a.points_h) return;
@@ -129,6 +168,16 @@ __global__ void __launch_bounds__(128) warp_kernel(const __grid_constant__ Kerne
         if (i >= a.points_w) break;
         float dx[K], dy[K];
         kernel::displacement(acc, p, a.extent, dx, dy);
+        if (a.out_kind == OutKind::Sums) {
+            float* g = a.sums + (static_cast<std::size_t>(j) * a.points_w + i) * kernel::sum_floats(K);
+            g[0] = acc.w[p];
+#pragma unroll
+            for (int k = 0; k < K; ++k) {
+                g[1 + 2 * k] = acc.dx[k][p];
+                g[2 + 2 * k] = acc.dy[k][p];
+            }
+            continue;
+        }
         if (a.out_kind == OutKind::Displacement) {
             float2* d = a.disp + (static_cast<std::size_t>(j) * a.points_w + i) * K;
 #pragma unroll
@@ -141,41 +190,87 @@ __global__ void __launch_bounds__(128) warp_kernel(const __grid_constant__ Kerne
     }
 }
 
-// Fast mode, pass 2: four pixels of one row a thread, all in one grid cell
-// (fast_cell is a multiple of 4): interpolate the cell's two columns in y
-// once, then along x; sample through the texture unit.
-template <int K>
-__global__ void __launch_bounds__(256) apply_kernel(const __grid_constant__ KernelArgs a) {
+// Fast mode, pass 2: one thread per cell lists the lines near it.
+__global__ void __launch_bounds__(128) near_kernel(const __grid_constant__ KernelArgs a,
+                                                   const __grid_constant__ LineTable table) {
+    const int t = blockIdx.x * blockDim.x + threadIdx.x;
+    if (t >= a.tiles_w * a.tiles_h) return;
+    const float* records = reinterpret_cast<const float*>(a.lines != nullptr ? a.lines : table.rec);
+    const int tx = t % a.tiles_w, ty = t / a.tiles_w;
+    const float half = 0.5f * static_cast<float>(a.cell);
+    const float cx = (static_cast<float>(tx * a.cell) + 0.5f + half) * a.inv_extent;
+    const float cy = (static_cast<float>(ty * a.cell) + 0.5f + half) * a.inv_extent;
+    a.near_count[t] = kernel::near_lines(records, a.record_floats, a.n_lines, cx, cy, a.reach,
+                                         a.near_list + static_cast<std::size_t>(t) * kernel::kMaxNear);
+}
+
+// Fast mode, pass 3: four pixels of one row a thread, all in one cell
+// (fast_cell is a multiple of 4): the cell's far sums interpolated, its near
+// lines added exactly (kernel.h, "fast mode"), then texture-unit sampling.
+template <int K, Law L>
+__global__ void __launch_bounds__(256) apply_kernel(const __grid_constant__ KernelArgs a,
+                                                    const __grid_constant__ LineTable table) {
+    constexpr int S = kernel::sum_floats(K);
     const int x0 = (blockIdx.x * blockDim.x + threadIdx.x) * 4;
     const int y = blockIdx.y * blockDim.y + threadIdx.y;
     if (x0 >= a.width || y >= a.height) return;
-    const int gx = x0 / a.cell, gy = y / a.cell;
+    const float* records = reinterpret_cast<const float*>(a.lines != nullptr ? a.lines : table.rec);
+    const int rf = a.record_floats;
+    const int tx = x0 / a.cell, ty = y / a.cell;
+    const int tile = ty * a.tiles_w + tx;
+    const int count = a.near_count[tile];
+    const unsigned short* list = a.near_list + static_cast<std::size_t>(tile) * kernel::kMaxNear;
+    const float inv = a.inv_extent;
+    const float xi = (static_cast<float>(x0) + 0.5f) * inv, yi = (static_cast<float>(y) + 0.5f) * inv;
+
+    // The cell's far sums at the two ends of this row segment (left and
+    // right grid columns); then each pixel on its own, to keep registers for
+    // occupancy (this pass waits on memory and the texture unit).
+    const bool crowded = count > kernel::kMaxNear;  // every line, exactly
     const float inv_cell = 1.0f / static_cast<float>(a.cell);
-    const float fy = static_cast<float>(y - gy * a.cell) * inv_cell;
-    const float2* top = a.grid + (static_cast<std::size_t>(gy) * a.grid_w + gx) * K;
-    const float2* bottom = top + static_cast<std::size_t>(a.grid_w) * K;
-    float lx[K], ly[K], rx[K], ry[K];
+    float left[S], right[S];
+    if (!crowded) {
+        const float fy = static_cast<float>(y - ty * a.cell) * inv_cell;
 #pragma unroll
-    for (int k = 0; k < K; ++k) {
-        const float2 t0 = top[k], t1 = top[K + k], b0 = bottom[k], b1 = bottom[K + k];
-        lx[k] = t0.x + fy * (b0.x - t0.x);
-        ly[k] = t0.y + fy * (b0.y - t0.y);
-        rx[k] = t1.x + fy * (b1.x - t1.x);
-        ry[k] = t1.y + fy * (b1.y - t1.y);
+        for (int side = 0; side < 2; ++side) {
+            const int gx = tx + side;
+            const float cx = (static_cast<float>(gx * a.cell) + 0.5f) * inv;
+            float top[S], bottom[S];
+            kernel::far_sums<K, L>(a.grid + (static_cast<std::size_t>(ty) * a.grid_w + gx) * S, records, rf, list,
+                                   count, cx, (static_cast<float>(ty * a.cell) + 0.5f) * inv, a.b, top);
+            kernel::far_sums<K, L>(a.grid + (static_cast<std::size_t>(ty + 1) * a.grid_w + gx) * S, records, rf,
+                                   list, count, cx, (static_cast<float>((ty + 1) * a.cell) + 0.5f) * inv, a.b,
+                                   bottom);
+#pragma unroll
+            for (int q = 0; q < S; ++q) (side == 0 ? left : right)[q] = top[q] + fy * (bottom[q] - top[q]);
+        }
     }
+
     const float unit = a.is_float ? 1.0f : 255.0f;
     unsigned int packed[4];
     float4 colours[4];
 #pragma unroll
     for (int p = 0; p < 4; ++p) {
         const int x = x0 + p;
-        const float fx = static_cast<float>(x - gx * a.cell) * inv_cell;
-        float dx[K], dy[K];
+        const float xp = xi + static_cast<float>(p) * inv;
+        Accum<K, 1> acc;
+        if (crowded) {
+            acc.clear();
+            for (int l = 0; l < a.n_lines; ++l)
+                kernel::accumulate_line<K, 1, L>(records + l * rf, xp, yi, 0.0f, a.b, acc);
+        } else {
+            const float fx = static_cast<float>(x - tx * a.cell) * inv_cell;
+            acc.w[0] = left[0] + fx * (right[0] - left[0]);
 #pragma unroll
-        for (int k = 0; k < K; ++k) {
-            dx[k] = lx[k] + fx * (rx[k] - lx[k]);
-            dy[k] = ly[k] + fx * (ry[k] - ly[k]);
+            for (int k = 0; k < K; ++k) {
+                acc.dx[k][0] = left[1 + 2 * k] + fx * (right[1 + 2 * k] - left[1 + 2 * k]);
+                acc.dy[k][0] = left[2 + 2 * k] + fx * (right[2 + 2 * k] - left[2 + 2 * k]);
+            }
+            for (int n = 0; n < count; ++n)
+                kernel::accumulate_line<K, 1, L>(records + list[n] * rf, xp, yi, 0.0f, a.b, acc);
         }
+        float dx[K], dy[K];
+        kernel::displacement(acc, 0, a.extent, dx, dy);
         if (a.out_kind == OutKind::Displacement) {
             if (x < a.width) {
                 float2* d = a.disp + (static_cast<std::size_t>(y) * a.width + x) * K;
@@ -247,16 +342,25 @@ void launch_warp_any(int k, int px, Law law, dim3 grid, dim3 block, std::size_t 
     }
 }
 
-void launch_apply_any(int k, dim3 grid, dim3 block, cudaStream_t s, const KernelArgs& a) {
+template <int K>
+void launch_apply_k(Law law, dim3 grid, dim3 block, cudaStream_t s, const KernelArgs& a, const LineTable& t) {
+    if (law == Law::InverseSquare)
+        apply_kernel<K, Law::InverseSquare><<<grid, block, 0, s>>>(a, t);
+    else
+        apply_kernel<K, Law::Power><<<grid, block, 0, s>>>(a, t);
+}
+
+void launch_apply_any(int k, Law law, dim3 grid, dim3 block, cudaStream_t s, const KernelArgs& a,
+                      const LineTable& t) {
     switch (k) {
-        case 1: apply_kernel<1><<<grid, block, 0, s>>>(a); break;
-        case 2: apply_kernel<2><<<grid, block, 0, s>>>(a); break;
-        case 3: apply_kernel<3><<<grid, block, 0, s>>>(a); break;
-        case 4: apply_kernel<4><<<grid, block, 0, s>>>(a); break;
-        case 5: apply_kernel<5><<<grid, block, 0, s>>>(a); break;
-        case 6: apply_kernel<6><<<grid, block, 0, s>>>(a); break;
-        case 7: apply_kernel<7><<<grid, block, 0, s>>>(a); break;
-        default: apply_kernel<8><<<grid, block, 0, s>>>(a); break;
+        case 1: launch_apply_k<1>(law, grid, block, s, a, t); break;
+        case 2: launch_apply_k<2>(law, grid, block, s, a, t); break;
+        case 3: launch_apply_k<3>(law, grid, block, s, a, t); break;
+        case 4: launch_apply_k<4>(law, grid, block, s, a, t); break;
+        case 5: launch_apply_k<5>(law, grid, block, s, a, t); break;
+        case 6: launch_apply_k<6>(law, grid, block, s, a, t); break;
+        case 7: launch_apply_k<7>(law, grid, block, s, a, t); break;
+        default: launch_apply_k<8>(law, grid, block, s, a, t); break;
     }
 }
 
@@ -295,6 +399,7 @@ public:
         EMOFACE_CUDA_CHECK(cudaSetDevice(device_));
         KernelArgs a{};
         a.n_lines = plan.lines;
+        a.record_floats = plan.record_floats;
         a.extent = plan.extent;
         a.inv_extent = plan.inv_extent;
         a.b = plan.b;
@@ -324,7 +429,7 @@ public:
         }
         const int rec4 = plan.record_floats / 4;
         a.chunk_lines = std::max(1, std::min(plan.lines, kSharedTableBytes / (rec4 * 16)));
-        const std::size_t smem = plan.lines > 0 ? static_cast<std::size_t>(a.chunk_lines) * rec4 * 16 : 0;
+        const std::size_t smem = static_cast<std::size_t>(a.chunk_lines) * rec4 * 16;
 
         // Where the pixels go.
         const bool positions = target.kind == OutputTarget::Kind::Positions;
@@ -360,18 +465,29 @@ public:
             a.cell = cell;
             a.grid_w = (width_ - 1) / cell + 2;
             const int grid_h = (height_ - 1) / cell + 2;
-            ensure(grid_, grid_bytes_, static_cast<std::size_t>(a.grid_w) * grid_h * plan.sources * sizeof(float2));
+            a.tiles_w = (width_ + cell - 1) / cell;
+            a.tiles_h = (height_ + cell - 1) / cell;
+            a.reach = (plan.fast_reach + 0.70711f) * static_cast<float>(cell) * plan.inv_extent;
+            const std::size_t tiles = static_cast<std::size_t>(a.tiles_w) * a.tiles_h;
+            ensure(grid_, grid_bytes_,
+                   static_cast<std::size_t>(a.grid_w) * grid_h * kernel::sum_floats(plan.sources) * sizeof(float));
+            ensure(near_count_, near_count_bytes_, tiles * sizeof(int));
+            ensure(near_list_, near_list_bytes_, tiles * kernel::kMaxNear * sizeof(unsigned short));
+            a.near_count = near_count_;
+            a.near_list = near_list_;
             KernelArgs g = a;
             g.points_w = a.grid_w;
             g.points_h = grid_h;
             g.spacing = static_cast<float>(cell);
-            g.out_kind = OutKind::Displacement;
-            g.disp = grid_;
+            g.out_kind = OutKind::Sums;
+            g.sums = grid_;
             launch_points(plan, g, smem, warp_block);
+            near_kernel<<<static_cast<unsigned>((tiles + 127) / 128), 128, 0, stream_>>>(a, table_);
+            EMOFACE_CUDA_CHECK(cudaGetLastError());
             a.grid = grid_;
             const dim3 block(32, 8);
             const dim3 blocks((width_ + 4 * 32 - 1) / (4 * 32), (height_ + 7) / 8);
-            launch_apply_any(plan.sources, blocks, block, stream_, a);
+            launch_apply_any(plan.sources, plan.law, blocks, block, stream_, a, table_);
             EMOFACE_CUDA_CHECK(cudaGetLastError());
         }
 
@@ -403,16 +519,23 @@ private:
     // blocks per multiprocessor.
     static constexpr int kSharedTableBytes = 32 * 1024;
 
-    void launch_points(const FramePlan& plan, const KernelArgs& a, std::size_t smem, dim3 block) {
+    void launch_points(const FramePlan& plan, const KernelArgs& args, std::size_t smem, dim3 block) {
         // Several points a thread amortise the line loads (8 where the sums
         // of up to 3 sources leave registers to spare, else 4); on small
-        // lattices that would leave the GPU too few threads, so take one.
+        // lattices that would leave the GPU too few threads, so take one
+        // point a thread and split the lines of a row over block.y threads.
+        KernelArgs a = args;
         const long long points = static_cast<long long>(a.points_w) * a.points_h;
         int px = 1;
         if (points >= (1 << 18)) px = 4;
         if (points >= (1 << 21) && plan.sources <= 3) px = 8;
         if (px_override_ > 0) px = px_override_;
-        const dim3 blocks((a.points_w + px * block.x - 1) / (px * block.x), (a.points_h + block.y - 1) / block.y);
+        a.line_split = px == 1 && split_lines_ ? static_cast<int>(block.y) : 1;
+        dim3 blocks((a.points_w + px * block.x - 1) / (px * block.x), (a.points_h + block.y - 1) / block.y);
+        if (a.line_split > 1) {
+            blocks.y = a.points_h;
+            smem += static_cast<std::size_t>(block.x) * block.y * kernel::sum_floats(plan.sources) * sizeof(float);
+        }
         launch_warp_any(plan.sources, px, plan.law, blocks, block, smem, stream_, a, table_);
         EMOFACE_CUDA_CHECK(cudaGetLastError());
     }
@@ -428,6 +551,7 @@ private:
     }
 
     void setup(const std::vector<KeyMap>& keys) {
+        if (const char* v = std::getenv("EMOFACE_MORPH_SPLIT")) split_lines_ = std::atoi(v) != 0;
         if (const char* px = std::getenv("EMOFACE_MORPH_PX")) {
             const int v = std::atoi(px);
             if (v == 1 || v == 4 || (v == 8 && keys.size() <= 3)) px_override_ = v;
@@ -489,6 +613,8 @@ private:
         keys_.clear();
         device_free(lines_);
         device_free(grid_);
+        device_free(near_count_);
+        device_free(near_list_);
         device_free(out_);
         device_free(disp_);
         if (staging_ != nullptr) cudaFreeHost(staging_);
@@ -502,7 +628,8 @@ private:
     int width_, height_;
     bool is_float_;
     std::size_t pixel_bytes_;
-    int px_override_ = 0;  // EMOFACE_MORPH_PX=1|4|8, for the benchmark's sweeps
+    int px_override_ = 0;       // EMOFACE_MORPH_PX=1|4|8, for the benchmark's sweeps
+    bool split_lines_ = true;   // EMOFACE_MORPH_SPLIT=0 turns the line split off (benchmark)
     int device_ = 0;
     cudaStream_t stream_ = nullptr;
     cudaEvent_t staged_ = nullptr;
@@ -511,8 +638,12 @@ private:
     std::size_t key_pitch_ = 0;
     float4* lines_ = nullptr;
     float* staging_ = nullptr;
-    float2* grid_ = nullptr;
+    float* grid_ = nullptr;
     std::size_t grid_bytes_ = 0;
+    int* near_count_ = nullptr;
+    std::size_t near_count_bytes_ = 0;
+    unsigned short* near_list_ = nullptr;
+    std::size_t near_list_bytes_ = 0;
     unsigned char* out_ = nullptr;
     std::size_t out_bytes_ = 0;
     float2* disp_ = nullptr;
@@ -552,7 +683,7 @@ const DeviceStatus& device_status() {
                         ", " + std::to_string(prop.multiProcessorCount) + " SMs)";
         // A device this binary has no code for (see CMAKE_CUDA_ARCHITECTURES).
         cudaFuncAttributes attr{};
-        if ((e = cudaFuncGetAttributes(&attr, apply_kernel<1>)) != cudaSuccess) {
+        if ((e = cudaFuncGetAttributes(&attr, near_kernel)) != cudaSuccess) {
             s.why = s.description + " has no matching kernel image in this build (" + cudaGetErrorString(e) +
                     "); add its architecture to CMAKE_CUDA_ARCHITECTURES";
             cudaGetLastError();

@@ -116,7 +116,11 @@ INSTANTIATE_TEST_SUITE_P(
         ParityCase{"fast_K2_N20", 100, 84, 2, 20, PixelFormat::Rgba8, false, 2.0f, Accuracy::Fast, -1},
         ParityCase{"fast_K7_N100_float", 128, 128, 7, 100, PixelFormat::RgbaF32, false, 2.0f, Accuracy::Fast, -1},
         ParityCase{"fast_normals_K3", 96, 64, 3, 30, PixelFormat::Rgba8, true, 2.0f, Accuracy::Fast, -1},
-        ParityCase{"fast_1024_K7_N40", 1024, 1024, 7, 40, PixelFormat::Rgba8, false, 2.0f, Accuracy::Fast, -1}),
+        ParityCase{"fast_1024_K7_N40", 1024, 1024, 7, 40, PixelFormat::Rgba8, false, 2.0f, Accuracy::Fast, -1},
+        ParityCase{"fast_power_K2", 200, 120, 2, 25, PixelFormat::Rgba8, false, 1.5f, Accuracy::Fast, -1},
+        // no lines: a plain blend
+        ParityCase{"exact_K2_N0", 64, 48, 2, 0, PixelFormat::Rgba8, false, 2.0f, Accuracy::Exact, -1},
+        ParityCase{"fast_K2_N0", 64, 48, 2, 0, PixelFormat::Rgba8, false, 2.0f, Accuracy::Fast, -1}),
     [](const auto& info) { return std::string(info.param.name); });
 
 KeyMap key(const void* pixels, Layout layout) {

@@ -69,6 +69,21 @@ TEST(MorphIdentity, FloatKeysAndSeveralSourcesBlendInPlace) {
     EXPECT_LT(max_abs_diff(out, expected), 1e-6);
 }
 
+TEST(MorphIdentity, NoLinesIsAPlainBlend) {
+    const int w = 24, h = 20;
+    const auto a = to_float(random_rgba8(w, h, 7)), b = to_float(random_rgba8(w, h, 8));
+    Morpher m(w, h, PixelFormat::RgbaF32, {key(a.data(), {}), key(b.data(), {})}, Backend::Cpu);
+    EXPECT_EQ(m.lines(), 0);
+    std::vector<float> out(a.size()), expected(a.size());
+    for (std::size_t i = 0; i < a.size(); ++i) expected[i] = 0.25f * a[i] + 0.75f * b[i];
+    for (Accuracy acc : {Accuracy::Exact, Accuracy::Fast}) {
+        MorphParams params;
+        params.accuracy = acc;
+        m.morph_to_host({}, {0.25f, 0.75f}, params, out.data());
+        EXPECT_LT(max_abs_diff(out, expected), 1e-6) << to_string(acc);
+    }
+}
+
 // ---- analytic maps -------------------------------------------------------------
 
 struct AnalyticCase {
