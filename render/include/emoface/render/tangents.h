@@ -42,10 +42,26 @@ public:
     // their faces had degenerate UVs or a tangent along the normal).
     std::size_t fallback_count() const { return fallback_count_; }
 
+    // The triangle list is read from the mesh once and kept while the mesh's
+    // vertex and face counts stay the same (a face's shape changes every
+    // frame, its connectivity does not). Call this after changing the
+    // connectivity of a mesh without changing those counts.
+    void invalidate_topology() { triangles_.clear(); }
+
 private:
+    void build_topology(const expression::TriMesh& mesh);
+
+    // Topology: 3 vertex indices per triangle, and each vertex's corners
+    // (3 * triangle + corner) in CSR form, so the per-vertex sums are
+    // gathered in a fixed order (the same result on any thread count).
+    std::vector<int> triangles_;
+    std::vector<int> corner_start_, corners_;
+    std::size_t topology_vertices_ = 0, topology_faces_ = 0;
+    // Per frame: unit normals, per-face dp/du and dp/dv (zero when the face
+    // is degenerate) and per-corner angles.
+    std::vector<glm::vec3> unit_normals_, face_t_, face_b_;
+    std::vector<float> corner_angle_;
     std::vector<glm::vec4> tangents_;
-    std::vector<glm::vec3> tangent_sum_;
-    std::vector<glm::vec3> bitangent_sum_;
     std::vector<glm::vec2> uv_scratch_;
     std::size_t fallback_count_ = 0;
 };
