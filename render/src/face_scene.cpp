@@ -206,6 +206,18 @@ bool FaceScene::uses_interop() const { return wrinkle_morph_->uses_interop(); }
 int FaceScene::key_count() const { return morpher_->keys(); }
 
 void FaceScene::update(const expression::FapValues& faps, const std::vector<float>& key_weights) {
+    update_geometry(faps);
+    update_wrinkles(key_weights);
+}
+
+void FaceScene::update_wrinkles(const std::vector<float>& key_weights) {
+    platform_.make_current();
+    const auto t = Clock::now();
+    wrinkle_morph_->update(target_, key_weights, params_);
+    times_.morph_ms = ms_since(t);
+}
+
+void FaceScene::update_geometry(const expression::FapValues& faps) {
     platform_.make_current();
     auto t = Clock::now();
     rig_.deform(faps, deformed_);
@@ -216,10 +228,6 @@ void FaceScene::update(const expression::FapValues& faps, const std::vector<floa
     layout_ = layout_of(deformed_.feature_points, present_points(face_), box_);
     target_ = to_morph_layout(expression::layout_segments(lines_, layout_));
     times_.layout_ms = ms_since(t);
-
-    t = Clock::now();
-    wrinkle_morph_->update(target_, key_weights, params_);
-    times_.morph_ms = ms_since(t);
 
     times_.uv_ms = times_.tangents_ms = times_.upload_ms = 0.0;
     for (Part& part : parts_) {

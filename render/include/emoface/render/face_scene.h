@@ -80,7 +80,12 @@ public:
 
     // One frame: the face deformed by `faps`, the keys blended by
     // `key_weights` (one per key, each >= 0, sum <= 1) onto the frame's layout.
+    // Same as update_geometry(faps) then update_wrinkles(key_weights).
     void update(const expression::FapValues& faps, const std::vector<float>& key_weights);
+    // The geometry half: rig, layout L*, wrinkle UVs, tangents, vertex upload.
+    void update_geometry(const expression::FapValues& faps);
+    // The wrinkle half: the morph onto the current L* into the texture.
+    void update_wrinkles(const std::vector<float>& key_weights);
 
     // Draws the three meshes (options.wrinkles false: without the wrinkle map).
     void draw(const DrawOptions& options);
@@ -95,6 +100,9 @@ public:
     int key_count() const;
     const expression::TriMesh& mesh() const { return mesh_; }
     const expression::FeatureLayout& layout() const { return layout_; }
+    // L* as the morph takes it (one line per feature line), and its parameters.
+    const morph::Layout& target_layout() const { return target_; }
+    const morph::MorphParams& morph_params() const { return params_; }
     WrinkleTexture& wrinkle_texture() { return *texture_; }
     morph::Morpher& morpher() { return *morpher_; }
     Renderer& renderer() { return *renderer_; }

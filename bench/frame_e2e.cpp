@@ -1,0 +1,351 @@
+// bench/frame_e2e: the whole frame on the GPU machine (issue 6). Per frame:
+// sample the FAP stream, rig, tangents, layout, morph of the K = 7 key maps
+// into the interop texture, bump-mapped draw, fence. Prints the thesis's
+// stage table (allocate, upload, per-frame morph, bump-mapped draw, whole
+// frame) as medians, and compares one frame with a reference render (the same
+// frame drawn on the CPU backend and llvmpipe, saved with --save), printing
+// the PSNR. Links neither OpenImageIO nor OpenCV, so it can be carried to the
+// GPU machine with its few libraries (frames are written as binary PPM).
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#if EMOFACE_BENCH_CUDA
+#include <cuda_runtime.h>
+#endif
+
+#include "emoface/common/error.h"
+#include "emoface/expression/default_face.h"
+#include "emoface/fap/fap_io.h"
+#include "emoface/render/face_scene.h"
+#include "emoface/render/platform.h"
+
+namespace {
+
+using namespace emoface;
+using Clock = std::chrono::steady_clock;
+
+double ms(Clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); }
+
+struct Series {
+    std::vector<double> v;
+    void add(double x) { v.push_back(x); }
+    double pct(double p) const {
+        if (v.empty()) return NAN;
+        std::vector<double> s = v;
+        const auto k = std::size_t(std::lround(p * double(s.size() - 1)));
+        std::nth_element(s.begin(), s.begin() + std::ptrdiff_t(k), s.end());
+        return s[k];
+    }
+    double median() const { return pct(0.5); }
+};
+
+void write_ppm(const std::string& path, const render::ImageRGBA8& img) {
+    const std::string temp = path + ".tmp";
+    {
+        std::ofstream f(temp, std::ios::binary);
+        f << "P6\n" << img.width << " " << img.height << "\n255\n";
+        for (std::size_t i = 0; i < img.pixels.size(); i += 4)
+            f.write(reinterpret_cast<const char*>(&img.pixels[i]), 3);
+        if (!f) fail("frame_e2e: cannot write {}", path);
+    }
+    if (std::rename(temp.c_str(), path.c_str()) != 0) fail("frame_e2e: cannot write {}", path);
+}
+
+render::ImageRGBA8 read_ppm(const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    std::string magic;
+    int w = 0, h = 0, maxv = 0;
+    f >> magic >> w >> h >> maxv;
+    f.get();
+    if (!f || magic != "P6" || maxv != 255 || w <= 0 || h <= 0 || w > 16384 || h > 16384)
+        fail<InputError>("frame_e2e: {}: not a binary 8-bit PPM", path);
+    render::ImageRGBA8 img(w, h);
+    std::vector<char> rgb(std::size_t(w) * h * 3);
+    f.read(rgb.data(), std::streamsize(rgb.size()));
+    if (!f) fail<InputError>("frame_e2e: {}: truncated", path);
+    for (std::size_t i = 0, n = std::size_t(w) * h; i < n; ++i) {
+        for (int c = 0; c < 3; ++c) img.pixels[4 * i + c] = std::uint8_t(rgb[3 * i + c]);
+        img.pixels[4 * i + 3] = 255;
+    }
+    return img;
+}
+
+double psnr(const render::ImageRGBA8& a, const render::ImageRGBA8& b) {
+    double se = 0.0;
+    for (std::size_t i = 0; i < a.pixels.size(); ++i) {
+        if (i % 4 == 3) continue;
+        const double d = double(a.pixels[i]) - double(b.pixels[i]);
+        se += d * d;
+    }
+    const double mse = se / (3.0 * a.width * a.height);
+    return mse == 0.0 ? INFINITY : 10.0 * std::log10(255.0 * 255.0 / mse);
+}
+
+// The key weights of a frame: FAP 2's two (emotion, intensity / 63) pairs,
+// neutral taking the rest. Codes 1..6 are joy .. surprise, the order of
+// expression::WrinkleKey after Neutral.
+std::vector<float> key_weights(const fap::FapFrame& frame) {
+    std::vector<float> w(expression::kWrinkleKeyCount, 0.0f);
+    if (frame.has(2)) {
+        const auto& e = frame.expression;
+        if (e.select1 >= 1 && e.select1 <= 6) w[std::size_t(e.select1)] += float(e.intensity1) / 63.0f;
+        if (e.select2 >= 1 && e.select2 <= 6) w[std::size_t(e.select2)] += float(e.intensity2) / 63.0f;
+    }
+    float sum = 0.0f;
+    for (std::size_t k = 1; k < w.size(); ++k) sum += w[k];
+    if (sum > 1.0f)
+        for (std::size_t k = 1; k < w.size(); ++k) w[k] /= sum;
+    w[0] = std::max(0.0f, 1.0f - std::min(sum, 1.0f));
+    return w;
+}
+
+// The face at each key expression's full intensity, where its key map is
+// made. Until the emotion profiles exist every key is made at the neutral
+// layout (the morph's cost does not depend on where the lines are).
+expression::FapValues key_pose(expression::WrinkleKey) { return expression::FapValues{}; }
+
+void fence() {
+    GLsync sync = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+    glClientWaitSync(sync, GL_SYNC_FLUSH_COMMANDS_BIT, GLuint64(10) * 1000000000ull);
+    glDeleteSync(sync);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"emoface end-to-end frame benchmark (FAP sample to fenced draw)"};
+    std::string data_dir = EMOFACE_DATA_DIR, fap_path, save, compare, backend_name = "auto";
+    int frames = 500, warmup = 30, map_size = 2048, width = 1920, height = 1080, samples = 4;
+    int check_frame = 25;
+    double face_scale = 1.0, min_psnr = 30.0;
+    app.add_option("--data", data_dir, "the project's data folder");
+    app.add_option("--fap", fap_path, "FAP file to play (default: data/fap/demo_tour.fap)");
+    app.add_option("--frames", frames, "timed frames (median over them)")->check(CLI::Range(1, 100000));
+    app.add_option("--warmup", warmup, "untimed frames first")->check(CLI::Range(0, 10000));
+    app.add_option("--map-size", map_size, "wrinkle map side")->check(CLI::Range(64, 8192));
+    app.add_option("--width", width)->check(CLI::Range(16, 8192));
+    app.add_option("--height", height)->check(CLI::Range(16, 8192));
+    app.add_option("--samples", samples, "MSAA samples")->check(CLI::Range(1, 16));
+    app.add_option("--face-scale", face_scale, "default face mesh resolution scale")->check(CLI::Range(0.1, 2.0));
+    app.add_option("--backend", backend_name, "morph backend: auto, cpu, cuda");
+    app.add_option("--check-frame", check_frame, "stream frame saved or compared");
+    app.add_option("--save", save, "write the check frame as PPM (the reference, on the CPU)");
+    app.add_option("--compare", compare, "PPM reference to compare the check frame with");
+    app.add_option("--min-psnr", min_psnr, "fail below this PSNR (dB)");
+    CLI11_PARSE(app, argc, argv);
+
+    try {
+        const morph::Backend backend = backend_name == "cpu"    ? morph::Backend::Cpu
+                                       : backend_name == "cuda" ? morph::Backend::Cuda
+                                                                : morph::Backend::Auto;
+        if (fap_path.empty()) fap_path = data_dir + "/fap/demo_tour.fap";
+        const fap::FapStream stream = fap::resolve_untransmitted(fap::read_fap_file(fap_path));
+
+        // Setup (not per frame): face, rig, keys.
+        auto t = Clock::now();
+        expression::DefaultFaceOptions face_options;
+        face_options.resolution_scale = face_scale;
+        const expression::Face face = expression::make_default_face(data_dir + "/face", face_options);
+        const expression::FaceRig rig(face);
+        const double face_ms = ms(Clock::now() - t);
+        t = Clock::now();
+        const auto spec = expression::load_wrinkle_spec(data_dir + "/expression/wrinkles.json");
+        std::bitset<expression::kFeatureCount> present;
+        for (int i = 0; i < expression::kFeatureCount; ++i) present[i] = face.feature_points[i].present;
+        auto lines = expression::lines_for_face(
+            expression::load_feature_lines(data_dir + "/expression/feature_lines.json"), present);
+        std::vector<render::WrinkleKey> keys;
+        for (int k = 0; k < expression::kWrinkleKeyCount; ++k)
+            keys.push_back(render::make_wrinkle_key(face, rig, spec, expression::WrinkleKey(k),
+                                                    key_pose(expression::WrinkleKey(k)),
+                                                    map_size));
+        const double keys_ms = ms(Clock::now() - t);
+
+        render::PlatformOptions po;
+        po.width = width;
+        po.height = height;
+        po.samples = samples;
+        po.cuda_device = 0;
+        render::HeadlessPlatform platform(po);
+        render::FaceSceneOptions so;
+        so.backend = backend;
+        t = Clock::now();
+        render::FaceScene scene(platform, face, rig, keys, lines, so);
+        const double scene_ms = ms(Clock::now() - t);
+        const morph::SetupTimes setup = scene.morpher().setup_times();
+
+        std::printf("frame_e2e: %s\n", platform.description().c_str());
+        std::printf("  morph: %s backend, %s; %d keys %dx%d, %zu lines; interop %s\n",
+                    morph::to_string(scene.morpher().backend()),
+                    morph::cuda_device_description().c_str(), scene.key_count(), map_size,
+                    map_size, lines.size(), scene.uses_interop() ? "yes" : "no");
+        std::printf("  face: %zu vertices, %zu triangles; frame %dx%d, %d samples; FAP %s, %zu frames at %g fps\n",
+                    face.mesh.n_vertices(), face.mesh.n_faces(), width, height, platform.samples(),
+                    fap_path.c_str(), stream.frames.size(), stream.fps);
+        std::printf("  setup: face+rig %.0f ms, keys %.0f ms, scene %.0f ms\n", face_ms, keys_ms, scene_ms);
+
+        render::DrawOptions draw;
+        draw.camera = scene.frontal_camera(float(width) / float(height));
+        draw.light = scene.portrait_light();
+
+        auto frame_at = [&](long i) {
+            return stream.sample(double(i % std::max<long>(1, long(stream.frames.size()))) / stream.fps);
+        };
+        auto faps_of = [](const fap::FapFrame& f) {
+            expression::FapValues v{};
+            std::copy(f.values.begin(), f.values.end(), v.begin());
+            return v;
+        };
+
+        // The check frame: saved (reference) or compared.
+        if (!save.empty() || !compare.empty()) {
+            const fap::FapFrame f = frame_at(check_frame);
+            scene.update(faps_of(f), key_weights(f));
+            platform.begin_frame();
+            scene.draw(draw);
+            platform.end_frame();
+            const render::ImageRGBA8 img = platform.read_rgba();
+            if (!save.empty()) {
+                write_ppm(save, img);
+                std::printf("  saved frame %d to %s\n", check_frame, save.c_str());
+            }
+            if (!compare.empty()) {
+                const render::ImageRGBA8 ref = read_ppm(compare);
+                if (ref.width != img.width || ref.height != img.height)
+                    fail("frame_e2e: reference {} is {}x{}, the frame {}x{}", compare, ref.width,
+                         ref.height, img.width, img.height);
+                const double p = psnr(img, ref);
+                std::printf("  check frame %d vs %s: PSNR %.1f dB (minimum %.1f)\n", check_frame,
+                            compare.c_str(), p, min_psnr);
+                write_ppm("frame_e2e_check.ppm", img);
+                if (!(p >= min_psnr)) {
+                    std::fprintf(stderr, "frame_e2e: FAILED: the frame differs from the reference (PSNR %.1f dB < %.1f); it is in frame_e2e_check.ppm\n", p, min_psnr);
+                    return 1;
+                }
+            }
+        }
+
+        // Pass 1: whole frames, nothing but the final fence synchronises.
+        Series whole;
+        for (long i = 0; i < warmup + frames; ++i) {
+            const auto t0 = Clock::now();
+            const fap::FapFrame f = frame_at(i);
+            scene.update(faps_of(f), key_weights(f));
+            platform.begin_frame();
+            scene.draw(draw);
+            platform.end_frame();
+            fence();
+            if (i >= warmup) whole.add(ms(Clock::now() - t0));
+        }
+
+        // Pass 2: the same frames with each stage timed on its own (host
+        // clocks, CUDA events around map + morph + unmap, a GL timer query
+        // around the draw), so the stages' sum exceeds pass 1's frame a little.
+        Series sample_s, rig_s, layout_s, uv_s, tangents_s, upload_s, map_s, unmap_s, morph_s, draw_s;
+        GLuint query = 0;
+        glGenQueries(1, &query);
+#if EMOFACE_BENCH_CUDA
+        cudaEvent_t ev0 = nullptr, ev1 = nullptr;
+        const bool cuda = scene.uses_interop();
+        if (cuda) {
+            cudaEventCreate(&ev0);
+            cudaEventCreate(&ev1);
+        }
+#endif
+        for (long i = 0; i < warmup + frames; ++i) {
+            auto t0 = Clock::now();
+            const fap::FapFrame f = frame_at(i);
+            const expression::FapValues faps = faps_of(f);
+            const std::vector<float> w = key_weights(f);
+            const double sample_ms = ms(Clock::now() - t0);
+            scene.update_geometry(faps);
+            const render::FrameStageTimes st = scene.last_times();
+            double map_ms = 0, unmap_ms = 0, morph_ms = 0;
+#if EMOFACE_BENCH_CUDA
+            if (cuda) {
+                void* stream_ptr = scene.morpher().cuda_stream();
+                auto s = static_cast<cudaStream_t>(stream_ptr);
+                cudaEventRecord(ev0, s);
+                t0 = Clock::now();
+                const unsigned long long surface = scene.wrinkle_texture().map_surface(stream_ptr);
+                map_ms = ms(Clock::now() - t0);
+                scene.morpher().morph_to_surface(scene.target_layout(), w, scene.morph_params(), surface);
+                t0 = Clock::now();
+                scene.wrinkle_texture().unmap(stream_ptr);
+                unmap_ms = ms(Clock::now() - t0);
+                cudaEventRecord(ev1, s);
+                cudaEventSynchronize(ev1);
+                float e = 0;
+                cudaEventElapsedTime(&e, ev0, ev1);
+                morph_ms = e;
+            } else
+#endif
+            {
+                t0 = Clock::now();
+                scene.update_wrinkles(w);
+                morph_ms = ms(Clock::now() - t0);
+            }
+            glBeginQuery(GL_TIME_ELAPSED, query);
+            platform.begin_frame();
+            scene.draw(draw);
+            platform.end_frame();
+            glEndQuery(GL_TIME_ELAPSED);
+            fence();
+            GLuint64 ns = 0;
+            glGetQueryObjectui64v(query, GL_QUERY_RESULT, &ns);
+            if (i < warmup) continue;
+            sample_s.add(sample_ms);
+            rig_s.add(st.rig_ms);
+            layout_s.add(st.layout_ms);
+            uv_s.add(st.uv_ms);
+            tangents_s.add(st.tangents_ms);
+            upload_s.add(st.upload_ms);
+            map_s.add(map_ms);
+            unmap_s.add(unmap_ms);
+            morph_s.add(morph_ms);
+            draw_s.add(double(ns) * 1e-6);
+        }
+        glDeleteQueries(1, &query);
+
+        std::printf("\nthesis stage table (medians over %d frames; ms)\n", frames);
+        std::printf("  %-44s %10s %10s\n", "stage", "median", "p90");
+        auto row = [](const char* name, double median, double p90) {
+            std::printf("  %-44s %10.3f %10.3f\n", name, median, p90);
+        };
+        row("allocate (once: key maps on the device)", setup.allocate_ms, setup.allocate_ms);
+        row("upload (once: key maps to the device)", setup.upload_ms, setup.upload_ms);
+        row("per-frame morph (map + kernel + unmap)", morph_s.median(), morph_s.pct(0.9));
+        row("bump-mapped draw (GL time, + MSAA resolve)", draw_s.median(), draw_s.pct(0.9));
+        row("whole frame (sample .. fence)", whole.median(), whole.pct(0.9));
+        std::printf("\nper-frame stages in detail (ms)\n");
+        row("sample the FAP stream", sample_s.median(), sample_s.pct(0.9));
+        row("rig (FAPs to mesh + normals)", rig_s.median(), rig_s.pct(0.9));
+        row("layout L* (feature points projected)", layout_s.median(), layout_s.pct(0.9));
+        row("wrinkle UVs (vertices projected)", uv_s.median(), uv_s.pct(0.9));
+        row("tangent frames", tangents_s.median(), tangents_s.pct(0.9));
+        row("vertex upload", upload_s.median(), upload_s.pct(0.9));
+        row("interop map (host)", map_s.median(), map_s.pct(0.9));
+        row("interop unmap (host)", unmap_s.median(), unmap_s.pct(0.9));
+        std::printf("  interop map+unmap per frame: %.1f us (median)\n",
+                    (map_s.median() + unmap_s.median()) * 1000.0);
+#if EMOFACE_BENCH_CUDA
+        if (cuda) {
+            cudaEventDestroy(ev0);
+            cudaEventDestroy(ev1);
+        }
+#endif
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "frame_e2e: %s\n", e.what());
+        return 1;
+    }
+    return 0;
+}
