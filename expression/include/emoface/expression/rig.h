@@ -1,0 +1,145 @@
+#pragma once
+// The FAP rig: low-level FAPs move a face's feature points, and the mesh
+// follows (DESIGN.md, "One frame").
+//
+// Each FAP moves its feature point by value x FAPU along the FAP table's
+// direction (x = face's left, y = up, z = to the viewer). Vertices follow
+// through the influence weights computed once in the constructor:
+//  - point FAPs (lips, chin boss, eyelids, brows, cheeks, nose, ears, tongue)
+//    act through a compact Shepard interpolation of the feature points'
+//    displacements over geodesic (along-the-mesh) distance, so an upper-lip
+//    FAP never reaches the lower lip across the closed mouth and a lid never
+//    reaches the other lid. The weights are infinite at a feature point, so
+//    each moves exactly by its own FAPs and no other, and fade to nothing at
+//    a radius scaled by ES0. Feature points no FAP moves that should stay put
+//    (eye corners, nose base, hairline, jaw corners, ear roots) are anchors.
+//  - on a face with eyeballs and eyelid margins, FAPs 19-22 close a lid along
+//    its whole length (the margin moves by the lid opening at each point) and
+//    lid skin slides over the eyeball instead of sinking into it;
+//  - FAP 3 (open_jaw) rotates the jaw, lower lip and chin about the jaw pivot
+//    so that 2.1 drops by value x MNS; 14 and 15 translate the jaw;
+//  - FAPs 23-28 rotate and thrust the eyeballs about their centres, 29/30
+//    grow the pupils by sliding the iris vertices over the eyeball;
+//  - FAPs 48-50 rotate the head about 7.1 (head pivot), fading down the neck.
+// Per frame the cost is a weighted sum over the precomputed influences plus
+// the rigid transforms: no allocation once `out` has its size.
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "emoface/expression/face.h"
+#include "emoface/fap/fap_table.h"
+
+namespace emoface::expression {
+
+// One value per FAP, index FAP number - 1 (as fap::FapFrame::values); FAPs 1
+// and 2 (viseme, expression) are ignored by the rig.
+using FapValues = std::array<double, fap::kFapCount>;
+
+struct RigOptions {
+    // Multiplies every influence radius (1 = the built-in radii, which scale
+    // with the face's eye separation ES0).
+    double radius_scale = 1.0;
+};
+
+// A face after one frame of FAPs.
+struct DeformedFace {
+    std::vector<TriMesh::Point> positions;  // one per mesh vertex
+    // Current positions of the 84 feature points, indexed like
+    // fap::feature_points(); absent ones stay (0, 0, 0).
+    fap::FeaturePointPositions feature_points{};
+};
+
+class FaceRig {
+public:
+    // Precomputes the influences; throws emoface::InputError when the face
+    // lacks what FAPU need or is inconsistent (validate_face()).
+    explicit FaceRig(const Face& face, const RigOptions& options = {});
+
+    void deform(const FapValues& faps, DeformedFace& out) const;
+    DeformedFace deform(const FapValues& faps) const;
+
+    // Only the feature points, without touching the mesh: cheap.
+    fap::FeaturePointPositions feature_points(const FapValues& faps) const;
+
+    // Writes `deformed` into `mesh` (a copy of the face's mesh) and
+    // recomputes its normals.
+    static void write_to(const DeformedFace& deformed, TriMesh& mesh);
+
+    // Whether FAP `fap` (1..68) moves anything on this face; when not,
+    // why_no_effect() says why ("" when it has an effect).
+    bool has_effect(int fap) const;
+    const std::string& why_no_effect(int fap) const;
+
+    int vertex_count() const { return static_cast<int>(neutral_.size()); }
+    // The radius (in the face's units) of a feature point's influence, 0 when
+    // it has none (for docs and tests).
+    double influence_radius(int feature_point) const;
+    // Number of (vertex, feature point) weights of the point FAPs.
+    std::size_t influence_count() const { return weights_.size(); }
+    // The jaw's share (0..1) of a vertex's motion under FAPs 3, 14, 15.
+    float jaw_weight(int vertex) const { return jaw_weight_.at(vertex); }
+
+private:
+    struct Influence {
+        std::uint16_t system;  // index into system_fps_
+        float weight;
+    };
+    struct EyeState {
+        int first = 0, count = 0;
+        std::array<double, 3> centre{};
+        double radius = 0, iris_angle = 0, pupil_angle = 0;
+        std::vector<float> polar, azimuth;  // per eyeball vertex, neutral
+    };
+    struct LidWeight {
+        int vertex;
+        int lid;  // index into lid_fps_
+        float weight;
+    };
+    struct LidVertex {
+        int vertex;
+        int eye;
+        float min_radius;
+    };
+
+    void build_point_field(const Face& face, double radius_scale);
+    void build_jaw(const Face& face);
+    void build_eyes(const Face& face);
+    void build_head(const Face& face);
+    void point_displacements(const FapValues& faps, std::array<std::array<double, 3>, 84>& d) const;
+
+    std::vector<TriMesh::Point> neutral_;
+    std::vector<VertexPart> parts_;
+    std::array<FeaturePointLocation, 84> fps_{};
+    fap::Fapu fapu_{};
+
+    // Point FAPs: feature points in the linear system and the weights of
+    // each vertex on them (CSR by vertex).
+    std::vector<int> system_fps_;           // feature point index per system entry
+    std::vector<double> system_radius_;     // kernel radius per system entry
+    std::vector<bool> system_held_;         // entries (and eyelid margins) the point field holds still
+    std::vector<int> influence_start_;      // size vertex_count + 1
+    std::vector<Influence> weights_;
+    std::array<int, 84> system_of_fp_{};    // -1 when not in the system
+
+    // Jaw.
+    std::vector<float> jaw_weight_;
+    std::vector<int> jaw_vertices_;
+    std::array<double, 3> jaw_pivot_{};
+    bool has_jaw_ = false;
+
+    // Eyes and eyelids.
+    std::vector<EyeState> eyes_;
+    std::vector<int> lid_fps_;              // 3.1-3.4 where the face has eyelid margins
+    std::vector<LidWeight> lid_weights_;
+    std::vector<LidVertex> lid_vertices_;
+
+    // Head.
+    std::array<double, 3> head_pivot_{};
+    std::vector<float> head_weight_;
+
+    std::array<std::string, fap::kFapCount> no_effect_{};
+};
+
+}  // namespace emoface::expression

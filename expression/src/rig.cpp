@@ -1,0 +1,601 @@
+#include "emoface/expression/rig.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <string_view>
+
+#include "emoface/common/error.h"
+#include "emoface/fap/feature_points.h"
+#include "emoface/fap/fapu.h"
+#include "geodesic.h"
+
+namespace emoface::expression {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+using V = std::array<double, 3>;
+
+V sub(V a, V b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+V add(V a, V b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
+V scale(V a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
+V to_v(const TriMesh::Point& p) { return {p[0], p[1], p[2]}; }
+
+double smoothstep(double e0, double e1, double x) {
+    const double t = std::clamp((x - e0) / (e1 - e0), 0.0, 1.0);
+    return t * t * (3 - 2 * t);
+}
+double raised_cosine(double t) { return t >= 1.0 ? 0.0 : 0.5 * (1.0 + std::cos(kPi * t)); }
+
+// Row-major 3x3 rotation matrices.
+using M3 = std::array<double, 9>;
+M3 rot_x(double a) { return {1, 0, 0, 0, std::cos(a), -std::sin(a), 0, std::sin(a), std::cos(a)}; }
+M3 rot_y(double a) { return {std::cos(a), 0, std::sin(a), 0, 1, 0, -std::sin(a), 0, std::cos(a)}; }
+M3 rot_z(double a) { return {std::cos(a), -std::sin(a), 0, std::sin(a), std::cos(a), 0, 0, 0, 1}; }
+M3 mul(const M3& a, const M3& b) {
+    M3 r{};
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            for (int k = 0; k < 3; ++k) r[i * 3 + j] += a[i * 3 + k] * b[k * 3 + j];
+    return r;
+}
+V mat_apply(const M3& m, V v) {
+    return {m[0] * v[0] + m[1] * v[1] + m[2] * v[2], m[3] * v[0] + m[4] * v[1] + m[5] * v[2],
+            m[6] * v[0] + m[7] * v[1] + m[8] * v[2]};
+}
+
+bool is_point_fap(int f) {
+    return (f >= 4 && f <= 13) || (f >= 16 && f <= 22) || (f >= 31 && f <= 46) || (f >= 51 && f <= 68);
+}
+
+// Kernel radius of a feature point as a fraction of ES0 (eye separation):
+// about the distance to its neighbours on the same feature, so neighbouring
+// kernels overlap like a partition of unity; wider where skin moves in
+// broad sheets (brows, cheeks, chin).
+double radius_factor(std::string_view id) {
+    static const std::map<std::string_view, double> table = {
+        {"2.2", 0.2},   {"2.3", 0.2},   {"2.4", 0.26},  {"2.5", 0.26},  {"2.6", 0.2},   {"2.7", 0.2},
+        {"2.8", 0.2},   {"2.9", 0.2},   {"2.10", 0.35}, {"2.11", 0.2},  {"2.12", 0.2},  {"2.13", 0.25},
+        {"2.14", 0.25}, {"3.1", 0.22},  {"3.2", 0.22},  {"3.3", 0.18},  {"3.4", 0.18},  {"3.7", 0.12},
+        {"3.8", 0.12},  {"3.11", 0.12}, {"3.12", 0.12}, {"4.1", 0.38},  {"4.2", 0.38},  {"4.3", 0.4},
+        {"4.4", 0.4},   {"4.5", 0.38},  {"4.6", 0.38},  {"5.1", 0.45},  {"5.2", 0.45},  {"5.3", 0.42},
+        {"5.4", 0.42},  {"6.1", 0.3},   {"6.2", 0.3},   {"6.3", 0.25},  {"6.4", 0.25},  {"8.1", 0.22},
+        {"8.2", 0.22},  {"8.3", 0.26},  {"8.4", 0.26},  {"8.5", 0.2},   {"8.6", 0.2},   {"8.7", 0.2},
+        {"8.8", 0.2},   {"8.9", 0.16},  {"8.10", 0.16}, {"9.1", 0.18},  {"9.2", 0.18},  {"9.3", 0.25},
+        {"10.1", 0.4},  {"10.2", 0.4},  {"10.3", 0.4},  {"10.4", 0.4},
+    };
+    auto it = table.find(id);
+    return it == table.end() ? 0.15 : it->second;
+}
+
+// Feature points no FAP moves that hold the skin around them in place.
+bool is_anchor(std::string_view id) {
+    static const char* anchors[] = {"3.7",  "3.8",  "3.11", "3.12", "9.4",  "9.5",  "9.6",  "9.7",  "9.12",
+                                    "9.13", "9.14", "9.15", "11.1", "11.2", "11.3", "2.11", "2.12", "2.13",
+                                    "2.14", "10.5", "10.6", "10.7", "10.8", "10.9", "10.10"};
+    for (const char* a : anchors)
+        if (id == a) return true;
+    return false;
+}
+
+// y of a margin polyline at x (linear between its vertices), and whether x
+// is within it.
+bool margin_y(const std::vector<std::array<double, 2>>& m, double x, double* y) {
+    for (std::size_t i = 0; i + 1 < m.size(); ++i) {
+        const double x0 = m[i][0], x1 = m[i + 1][0];
+        if ((x >= x0 && x <= x1) || (x >= x1 && x <= x0)) {
+            const double t = x1 == x0 ? 0.0 : (x - x0) / (x1 - x0);
+            *y = m[i][1] + t * (m[i + 1][1] - m[i][1]);
+            return true;
+        }
+    }
+    return false;
+}
+
+}  // namespace
+
+FaceRig::FaceRig(const Face& face, const RigOptions& options) {
+    validate_face(face, "face \"" + face.name + "\"");
+    if (!(options.radius_scale > 0.05 && options.radius_scale < 20))
+        fail<InputError>("expression: rig: radius_scale must be in (0.05, 20), found {}", options.radius_scale);
+    const int n = face.vertex_count();
+    neutral_.resize(n);
+    for (int v = 0; v < n; ++v) neutral_[v] = face.mesh.point(TriMesh::VertexHandle(v));
+    parts_ = face.parts;
+    fps_ = face.feature_points;
+    fapu_ = face.fapu;
+    if (!(fapu_.es > 0 && fapu_.mns > 0 && fapu_.mw > 0 && fapu_.ens > 0 && fapu_.irisd > 0))
+        fail<InputError>("expression: rig: face \"{}\" has no FAPU (call update_fapu)", face.name);
+
+    build_point_field(face, options.radius_scale);
+    build_jaw(face);
+    build_eyes(face);
+    build_head(face);
+
+    for (int f = 1; f <= fap::kFapCount; ++f) {
+        std::string& why = no_effect_[f - 1];
+        if (f <= 2) {
+            why = "high-level FAP: face_state() turns it into low-level FAPs";
+            continue;
+        }
+        const auto& info = fap::fap_info(f);
+        const auto fp = fap::find_feature_point(info.feature_point);
+        if (is_point_fap(f) || f == 47) {
+            const bool ok = fp && system_of_fp_[*fp] >= 0 &&
+                            (f != 47 || system_of_fp_[fap::feature_point_index("6.4")] >= 0) &&
+                            (!system_held_[system_of_fp_[*fp]] ||
+                             std::find(lid_fps_.begin(), lid_fps_.end(), *fp) != lid_fps_.end());
+            if (!ok)
+                why = fmt::format("the face has no vertex for feature point {}", std::string(info.feature_point));
+        } else if (f == 3 || f == 14 || f == 15) {
+            if (!has_jaw_) why = "the face lacks the chin or lip feature points the jaw needs";
+        } else if (f >= 23 && f <= 30) {
+            const bool left = (f % 2) == 1;
+            bool found = false;
+            for (const EyeState& e : eyes_) found |= (e.centre[0] > 0) == left;
+            if (!found) why = "the face has no eyeball meshes";
+        }
+    }
+}
+
+void FaceRig::build_point_field(const Face& face, double radius_scale) {
+    const int n = face.vertex_count();
+    const double es0 = fapu_.es * 1024.0;
+    system_of_fp_.fill(-1);
+
+    // Eyelid margins (faces with eyeballs): the lid FAPs close a lid along
+    // its whole margin, in proportion to the opening at each point, through
+    // their own field; the point field holds the margins still.
+    struct Lid {
+        std::vector<std::array<double, 2>> upper, lower;
+        std::vector<int> vertices;
+    };
+    std::array<Lid, 2> lids;
+    std::array<bool, 2> has_lid{false, false};
+    for (const Eyeball& eb : face.eyeballs) {
+        if (eb.upper_margin.size() < 3) continue;
+        const int side = eb.centre[0] > 0 ? 0 : 1;
+        has_lid[side] = true;
+        for (int v : eb.upper_margin) lids[side].upper.push_back({neutral_[v][0], neutral_[v][1]});
+        for (int v : eb.lower_margin) lids[side].lower.push_back({neutral_[v][0], neutral_[v][1]});
+        lids[side].vertices = eb.upper_margin;
+        lids[side].vertices.insert(lids[side].vertices.end(), eb.lower_margin.begin(), eb.lower_margin.end());
+    }
+    auto lid_side = [](std::string_view id) { return (id == "3.1" || id == "3.3") ? 0 : 1; };
+    auto is_lid = [&](std::string_view id) {
+        return (id == "3.1" || id == "3.2" || id == "3.3" || id == "3.4") && has_lid[lid_side(id)];
+    };
+
+    // Which feature points take part: those a point FAP moves, and anchors.
+    std::array<bool, 84> driven{};
+    for (int f = 3; f <= fap::kFapCount; ++f) {
+        if (!is_point_fap(f) && f != 47) continue;
+        const auto fp = fap::find_feature_point(fap::fap_info(f).feature_point);
+        if (fp) driven[*fp] = true;
+        if (f == 47) driven[fap::feature_point_index("6.4")] = true;
+    }
+    struct Entry {
+        std::vector<int> sources;
+        double radius;
+        bool held;  // displacement always 0 in the point field
+    };
+    std::vector<Entry> entries;
+    std::map<int, int> entry_of_vertex;
+    for (int k = 0; k < fap::kFeaturePointCount; ++k) {
+        const FeaturePointLocation& fp = fps_[k];
+        if (!fp.present || fp.vertex < 0) continue;
+        const auto id = fap::feature_points()[k].id;
+        if (!driven[k] && !is_anchor(id)) continue;
+        // Points that share a vertex share one entry (Candide-3 has a few).
+        auto [it, inserted] = entry_of_vertex.emplace(fp.vertex, static_cast<int>(entries.size()));
+        if (inserted) {
+            entries.push_back({{fp.vertex}, radius_factor(id) * es0 * radius_scale, is_lid(id)});
+            system_fps_.push_back(k);
+        }
+        system_of_fp_[k] = it->second;
+    }
+    // Neighbouring points of one feature (a brow, a lip contour) must
+    // overlap, or the skin between two points moved alike sags: each radius
+    // reaches 1.3 times as far as the nearest driven point of its group, up
+    // to twice its table value.
+    for (std::size_t j = 0; j < entries.size(); ++j) {
+        const int k = system_fps_[j];
+        if (!driven[k]) continue;
+        const int group = fap::feature_points()[k].group;
+        double nearest = 1e30;
+        for (std::size_t i = 0; i < entries.size(); ++i) {
+            const int q = system_fps_[i];
+            if (i == j || !driven[q] || fap::feature_points()[q].group != group) continue;
+            const V d = sub(fps_[k].position, fps_[q].position);
+            nearest = std::min(nearest, std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]));
+        }
+        if (nearest < 1e29) entries[j].radius = std::clamp(1.3 * nearest, entries[j].radius, 2.0 * entries[j].radius);
+    }
+    for (const Entry& e : entries) system_radius_.push_back(e.radius);
+    for (int side = 0; side < 2; ++side)
+        if (has_lid[side]) entries.push_back({lids[side].vertices, 0.1 * es0 * radius_scale, true});
+    system_held_.clear();
+    for (const Entry& e : entries) system_held_.push_back(e.held);
+
+    // Shepard interpolation with compact support: weight ((R - g) / g)^2 of
+    // geodesic distance g, infinite at a feature point (which so moves
+    // exactly by its own displacement) and 0 at R; a constant background
+    // weight for "no motion" makes the field fade to 0 away from all points.
+    // Weights are a convex combination, so nothing overshoots.
+    constexpr double kBackground = 0.15;
+    detail::GeodesicGraph graph(face.mesh);
+    std::vector<std::vector<std::pair<int, double>>> reach(n);  // (entry, distance)
+    for (std::size_t j = 0; j < entries.size(); ++j)
+        for (auto [v, g] : graph.within(entries[j].sources, entries[j].radius))
+            reach[v].emplace_back(static_cast<int>(j), g);
+    influence_start_.assign(n + 1, 0);
+    for (int v = 0; v < n; ++v) {
+        influence_start_[v] = static_cast<int>(weights_.size());
+        if (reach[v].empty()) continue;
+        int at = -1;
+        double total = kBackground;
+        std::vector<double> w(reach[v].size());
+        for (std::size_t q = 0; q < reach[v].size(); ++q) {
+            const auto [j, g] = reach[v][q];
+            if (g <= 1e-9) at = j;
+            const double r = entries[j].radius;
+            w[q] = g > 1e-9 ? ((r - g) / g) * ((r - g) / g) : 0.0;
+            total += w[q];
+        }
+        if (at >= 0) {
+            if (!entries[at].held) weights_.push_back({static_cast<std::uint16_t>(at), 1.0f});
+            continue;
+        }
+        for (std::size_t q = 0; q < reach[v].size(); ++q) {
+            const int j = reach[v][q].first;
+            const double wq = w[q] / total;
+            if (!entries[j].held && wq > 1e-5) weights_.push_back({static_cast<std::uint16_t>(j), static_cast<float>(wq)});
+        }
+    }
+    influence_start_[n] = static_cast<int>(weights_.size());
+
+    // The lid field: the margin moves by (opening here / opening at the
+    // feature point) times the lid FAP, the lid skin beyond it less and less.
+    for (int k = 0; k < fap::kFeaturePointCount; ++k) {
+        const auto id = fap::feature_points()[k].id;
+        if (!is_lid(id) || !fps_[k].present || fps_[k].vertex < 0) continue;
+        const int side = lid_side(id);
+        const bool upper = id == "3.1" || id == "3.2";
+        auto opening = [&](double x) {
+            double yu, yl;
+            if (!margin_y(lids[side].upper, x, &yu) || !margin_y(lids[side].lower, x, &yl)) return 0.0;
+            return std::max(yu - yl, 0.0);
+        };
+        const auto& margin = upper ? lids[side].upper : lids[side].lower;
+        const int src = fps_[k].vertex;
+        const double o_fp = opening(neutral_[src][0]);
+        if (o_fp <= 0) fail("expression: rig: the eye opening at feature point {} is closed", std::string(id));
+        const double fade = (upper ? 0.14 : 0.1) * es0 * radius_scale;
+        const int lid = static_cast<int>(lid_fps_.size());
+        lid_fps_.push_back(k);
+        for (auto [v, g] : graph.within({src}, 0.35 * es0 * radius_scale)) {
+            if (parts_[v] != VertexPart::Skin) continue;
+            const double x = neutral_[v][0], y = neutral_[v][1];
+            double ym;
+            if (!margin_y(margin, x, &ym)) continue;
+            const double h = upper ? y - ym : ym - y;  // beyond the margin, away from the opening
+            if (h < -1e-3) continue;
+            const double w = std::min(opening(x) / o_fp, 1.0) * raised_cosine(std::max(h, 0.0) / fade);
+            if (w > 1e-5) lid_weights_.push_back({v, lid, static_cast<float>(v == src ? 1.0 : w)});
+        }
+    }
+}
+
+void FaceRig::build_jaw(const Face& face) {
+    const int n = face.vertex_count();
+    jaw_weight_.assign(n, 0.0f);
+    for (int v = 0; v < n; ++v)
+        if (parts_[v] == VertexPart::MouthLower || parts_[v] == VertexPart::Tongue) jaw_weight_[v] = 1.0f;
+    auto idx = [](const char* id) { return fap::feature_point_index(id); };
+    for (const char* id : {"2.1", "2.2", "2.3", "2.4", "2.5"})
+        if (!fps_[idx(id)].present) {
+            for (int v = 0; v < n; ++v)
+                if (jaw_weight_[v] > 0) jaw_vertices_.push_back(v);
+            has_jaw_ = false;
+            return;
+        }
+    has_jaw_ = true;
+    jaw_pivot_ = face.jaw_pivot;
+    const double es0 = fapu_.es * 1024.0;
+    const V p22 = fps_[idx("2.2")].position, p23 = fps_[idx("2.3")].position;
+    const V pl = fps_[idx("2.4")].position, pr = fps_[idx("2.5")].position;
+    const double chin_y = fps_[idx("2.1")].position[1];
+    const double mx = 0.5 * (pl[0] + pr[0]), half_width = 0.5 * std::abs(pl[0] - pr[0]);
+    const double y_mid = 0.5 * (p22[1] + p23[1]), y_corner = 0.5 * (pl[1] + pr[1]);
+    const double z_corner = 0.5 * (pl[2] + pr[2]);
+    const V P = jaw_pivot_;
+    const double delta = 0.16 * es0;
+
+    // Which side of the mouth a vertex is on, by distance along the skin:
+    // across the closed lips the two sides are far apart.
+    detail::GeodesicGraph graph(face.mesh);
+    auto sources = [&](std::initializer_list<const char*> ids) {
+        std::vector<int> s;
+        for (const char* id : ids)
+            if (fps_[idx(id)].present && fps_[idx(id)].vertex >= 0) s.push_back(fps_[idx(id)].vertex);
+        return s;
+    };
+    const double lip_zone = 0.5 * es0;
+    std::vector<double> to_upper(n, 1e30), to_lower(n, 1e30);
+    for (auto [v, g] : graph.within(sources({"2.2", "2.6", "2.7"}), lip_zone)) to_upper[v] = g;
+    for (auto [v, g] : graph.within(sources({"2.3", "2.8", "2.9"}), lip_zone)) to_lower[v] = g;
+
+    for (int v = 0; v < n; ++v) {
+        if (parts_[v] != VertexPart::Skin) continue;
+        const double x = neutral_[v][0], y = neutral_[v][1], z = neutral_[v][2];
+        double line;
+        if (z >= z_corner) {
+            line = y_mid + (y_corner - y_mid) * std::min(std::abs(x - mx) / half_width, 1.0);
+        } else {
+            const double t = std::clamp((z_corner - z) / std::max(z_corner - P[2], 1e-9), 0.0, 1.0);
+            line = y_corner + (P[1] - y_corner) * t;
+        }
+        double w = smoothstep(delta, -delta, y - line);
+        if (to_upper[v] < 1e29 || to_lower[v] < 1e29) {
+            const double lip = 1.0 - smoothstep(0.8 * half_width, 1.05 * half_width, std::abs(x - mx));
+            w = to_lower[v] < to_upper[v] ? std::max(w, lip) : std::min(w, 1.0 - lip);
+        }
+        // The neck below the chin and the head behind the jaw joint stay.
+        w *= smoothstep(chin_y - 0.45 * es0, chin_y - 0.08 * es0, y);
+        w *= smoothstep(P[2] - 0.2 * es0, P[2] + 0.15 * es0, z);
+        jaw_weight_[v] = static_cast<float>(w);
+    }
+    for (int v = 0; v < n; ++v)
+        if (jaw_weight_[v] > 1e-4f) jaw_vertices_.push_back(v);
+}
+
+void FaceRig::build_eyes(const Face& face) {
+    double clearance = 1e30;
+    for (const Eyeball& eb : face.eyeballs) {
+        EyeState e;
+        e.first = eb.vertices.first;
+        e.count = eb.vertices.count;
+        e.centre = eb.centre;
+        e.radius = eb.radius;
+        e.iris_angle = eb.iris_angle;
+        e.pupil_angle = eb.pupil_angle;
+        for (int v = e.first; v < e.first + e.count; ++v) {
+            const V d = sub(to_v(neutral_[v]), e.centre);
+            const double r = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            e.polar.push_back(static_cast<float>(r > 0 ? std::acos(std::clamp(d[2] / r, -1.0, 1.0)) : 0.0));
+            e.azimuth.push_back(static_cast<float>(std::atan2(d[1], d[0])));
+        }
+        for (const auto* margin : {&eb.upper_margin, &eb.lower_margin})
+            for (int v : *margin) {
+                const V d = sub(to_v(neutral_[v]), e.centre);
+                clearance = std::min(clearance, std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) - e.radius);
+            }
+        eyes_.push_back(std::move(e));
+    }
+    // Skin in front of an eyeball keeps at least its neutral clearance (the
+    // margins' at most), so a closing lid slides over the eye.
+    if (clearance > 1e29) return;
+    clearance = std::max(clearance, 0.0);
+    for (int v = 0; v < static_cast<int>(neutral_.size()); ++v) {
+        if (parts_[v] != VertexPart::Skin) continue;
+        for (std::size_t e = 0; e < eyes_.size(); ++e) {
+            const V d = sub(to_v(neutral_[v]), eyes_[e].centre);
+            const double r = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            if (d[2] <= 0 || r > eyes_[e].radius * 1.8) continue;
+            const double min_r = eyes_[e].radius + std::min(std::max(r - eyes_[e].radius, 0.0), clearance);
+            lid_vertices_.push_back({v, static_cast<int>(e), static_cast<float>(min_r)});
+        }
+    }
+}
+
+void FaceRig::build_head(const Face& face) {
+    head_pivot_ = face.head_pivot;
+    const double es0 = fapu_.es * 1024.0;
+    head_weight_.assign(neutral_.size(), 1.0f);
+    for (std::size_t v = 0; v < neutral_.size(); ++v)
+        if (parts_[v] == VertexPart::Skin)
+            head_weight_[v] = static_cast<float>(smoothstep(head_pivot_[1] - 0.9 * es0, head_pivot_[1], neutral_[v][1]));
+}
+
+void FaceRig::point_displacements(const FapValues& faps, std::array<std::array<double, 3>, 84>& d) const {
+    for (auto& v : d) v = {0.0, 0.0, 0.0};
+    for (int f = 4; f <= fap::kFapCount; ++f) {
+        const double value = faps[f - 1];
+        if (value == 0.0 || !(is_point_fap(f) || f == 47)) continue;
+        const auto& info = fap::fap_info(f);
+        if (f == 47) {
+            // Tongue roll: both borders curl up by the angle over the tongue's half width.
+            const int c = fap::feature_point_index("6.2");
+            for (const char* id : {"6.3", "6.4"}) {
+                const int k = fap::feature_point_index(id);
+                if (!fps_[k].present || !fps_[c].present) continue;
+                const double half = std::abs(fps_[k].position[0] - fps_[c].position[0]);
+                d[k][1] += half * std::sin(value * fapu_.au);
+            }
+            continue;
+        }
+        const auto fp = fap::find_feature_point(info.feature_point);
+        if (!fp) continue;
+        const double s = value * fapu_.of(info.unit);
+        for (int c = 0; c < 3; ++c) d[*fp][c] += s * info.direction[c];
+    }
+}
+
+void FaceRig::deform(const FapValues& faps, DeformedFace& out) const {
+    const int n = static_cast<int>(neutral_.size());
+    out.positions.assign(neutral_.begin(), neutral_.end());
+    auto& pos = out.positions;
+
+    // Point FAPs.
+    std::array<std::array<double, 3>, 84> fp_d;
+    point_displacements(faps, fp_d);
+    std::vector<std::array<double, 3>> d(system_held_.size(), {0.0, 0.0, 0.0});
+    bool any = false;
+    for (int k = 0; k < fap::kFeaturePointCount; ++k) {
+        const int j = system_of_fp_[k];
+        if (j < 0 || system_held_[j]) continue;
+        for (int c = 0; c < 3; ++c) d[j][c] += fp_d[k][c];
+        any |= fp_d[k][0] != 0 || fp_d[k][1] != 0 || fp_d[k][2] != 0;
+    }
+    if (any) {
+        for (int v = 0; v < n; ++v) {
+            double dx = 0, dy = 0, dz = 0;
+            for (int k = influence_start_[v]; k < influence_start_[v + 1]; ++k) {
+                const auto& dj = d[weights_[k].system];
+                const double w = weights_[k].weight;
+                dx += w * dj[0];
+                dy += w * dj[1];
+                dz += w * dj[2];
+            }
+            pos[v] += TriMesh::Point(static_cast<float>(dx), static_cast<float>(dy), static_cast<float>(dz));
+        }
+    }
+    bool lids_move = false;
+    for (int k : lid_fps_) lids_move |= fp_d[k][0] != 0 || fp_d[k][1] != 0 || fp_d[k][2] != 0;
+    if (lids_move)
+        for (const LidWeight& lw : lid_weights_) {
+            const auto& dk = fp_d[lid_fps_[lw.lid]];
+            pos[lw.vertex] += TriMesh::Point(static_cast<float>(lw.weight * dk[0]), static_cast<float>(lw.weight * dk[1]),
+                                             static_cast<float>(lw.weight * dk[2]));
+        }
+    if (any || lids_move) {
+        // Lids slide over the eyeballs.
+        for (const LidVertex& lv : lid_vertices_) {
+            const EyeState& e = eyes_[lv.eye];
+            auto& p = pos[lv.vertex];
+            const double dx = p[0] - e.centre[0], dy = p[1] - e.centre[1], dz = p[2] - e.centre[2];
+            const double r2 = dx * dx + dy * dy + dz * dz, m2 = double(lv.min_radius) * lv.min_radius;
+            if (r2 >= m2 || dx * dx + dy * dy >= m2) continue;
+            p[2] = static_cast<float>(e.centre[2] + std::sqrt(m2 - dx * dx - dy * dy));
+        }
+    }
+
+    // Jaw: rotate about the pivot so that 2.1 drops by FAP 3 x MNS, then
+    // thrust (14) and shift (15).
+    const double open = faps[2], thrust = faps[13], shift = faps[14];
+    if (has_jaw_ && (open != 0 || thrust != 0 || shift != 0)) {
+        const V chin = sub(fps_[fap::feature_point_index("2.1")].position, jaw_pivot_);
+        const double drop = open * fapu_.mns;
+        const double a = std::hypot(chin[1], chin[2]);
+        const double phi0 = std::atan2(chin[2], chin[1]);
+        const double angle = a > 0 ? std::acos(std::clamp((chin[1] - drop) / a, -1.0, 1.0)) - phi0 : 0.0;
+        const M3 r = rot_x(angle);
+        const auto& i14 = fap::fap_info(14);
+        const auto& i15 = fap::fap_info(15);
+        V t{0, 0, 0};
+        for (int c = 0; c < 3; ++c)
+            t[c] = thrust * fapu_.of(i14.unit) * i14.direction[c] + shift * fapu_.of(i15.unit) * i15.direction[c];
+        for (int v : jaw_vertices_) {
+            const V p = to_v(pos[v]);
+            const V moved = add(add(mat_apply(r, sub(p, jaw_pivot_)), jaw_pivot_), t);
+            const double w = jaw_weight_[v];
+            pos[v] = TriMesh::Point(static_cast<float>(p[0] + w * (moved[0] - p[0])),
+                                    static_cast<float>(p[1] + w * (moved[1] - p[1])),
+                                    static_cast<float>(p[2] + w * (moved[2] - p[2])));
+        }
+    }
+
+    // Eyeballs.
+    for (const EyeState& e : eyes_) {
+        const bool left = e.centre[0] > 0;
+        const double yaw = faps[left ? 22 : 23], pitch = faps[left ? 24 : 25];
+        const double thrust_e = faps[left ? 26 : 27], dilate = faps[left ? 28 : 29];
+        if (yaw == 0 && pitch == 0 && thrust_e == 0 && dilate == 0) continue;
+        const M3 r = mul(rot_y(yaw * fapu_.au), rot_x(pitch * fapu_.au));
+        const V t{0, 0, thrust_e * fapu_.es};
+        const double sin_p = std::sin(e.pupil_angle) * e.radius;
+        const double iris_r = std::sin(e.iris_angle) * e.radius;
+        const double pupil_r = std::clamp(sin_p + 0.5 * dilate * fapu_.irisd, 0.12 * iris_r, 0.95 * iris_r);
+        const double new_pupil = std::asin(std::min(pupil_r / e.radius, 1.0));
+        for (int k = 0; k < e.count; ++k) {
+            const int v = e.first + k;
+            V d = sub(to_v(neutral_[v]), e.centre);
+            if (dilate != 0 && e.polar[k] < e.iris_angle) {
+                const double r = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+                const double a = e.polar[k];
+                const double na = a < e.pupil_angle
+                                      ? a * new_pupil / e.pupil_angle
+                                      : new_pupil + (a - e.pupil_angle) * (e.iris_angle - new_pupil) /
+                                                        (e.iris_angle - e.pupil_angle);
+                d = {r * std::sin(na) * std::cos(e.azimuth[k]), r * std::sin(na) * std::sin(e.azimuth[k]),
+                     r * std::cos(na)};
+            }
+            const V p = add(add(mat_apply(r, d), e.centre), t);
+            pos[v] = TriMesh::Point(static_cast<float>(p[0]), static_cast<float>(p[1]), static_cast<float>(p[2]));
+        }
+    }
+
+    // Head: pitch (48, front down), yaw (49, front to the face's left), roll
+    // (50, top to the face's right), about 7.1.
+    const double hp = faps[47], hy = faps[48], hr = faps[49];
+    M3 head{1, 0, 0, 0, 1, 0, 0, 0, 1};
+    const bool turn = hp != 0 || hy != 0 || hr != 0;
+    if (turn) {
+        head = mul(rot_y(hy * fapu_.au), mul(rot_x(hp * fapu_.au), rot_z(hr * fapu_.au)));
+        for (int v = 0; v < n; ++v) {
+            const double w = head_weight_[v];
+            if (w <= 0) continue;
+            const V p = to_v(pos[v]);
+            const V moved = add(mat_apply(head, sub(p, head_pivot_)), head_pivot_);
+            pos[v] = TriMesh::Point(static_cast<float>(p[0] + w * (moved[0] - p[0])),
+                                    static_cast<float>(p[1] + w * (moved[1] - p[1])),
+                                    static_cast<float>(p[2] + w * (moved[2] - p[2])));
+        }
+    }
+
+    for (int k = 0; k < fap::kFeaturePointCount; ++k) {
+        const FeaturePointLocation& fp = fps_[k];
+        if (!fp.present) {
+            out.feature_points[k] = {0, 0, 0};
+        } else if (fp.vertex >= 0) {
+            out.feature_points[k] = to_v(pos[fp.vertex]);
+        } else if (turn) {
+            // Free points (7.1, 11.5) turn with the head where the skin would.
+            const double w = smoothstep(head_pivot_[1] - 0.9 * fapu_.es * 1024.0, head_pivot_[1], fp.position[1]);
+            const V moved = add(mat_apply(head, sub(fp.position, head_pivot_)), head_pivot_);
+            out.feature_points[k] = add(fp.position, scale(sub(moved, fp.position), w));
+        } else {
+            out.feature_points[k] = fp.position;
+        }
+    }
+}
+
+DeformedFace FaceRig::deform(const FapValues& faps) const {
+    DeformedFace out;
+    deform(faps, out);
+    return out;
+}
+
+fap::FeaturePointPositions FaceRig::feature_points(const FapValues& faps) const {
+    // The full deformation is cheap enough at face sizes, and one code path
+    // keeps the points and the mesh consistent.
+    return deform(faps).feature_points;
+}
+
+void FaceRig::write_to(const DeformedFace& deformed, TriMesh& mesh) {
+    if (deformed.positions.size() != mesh.n_vertices())
+        fail("expression: rig: {} deformed positions for a mesh of {} vertices", deformed.positions.size(),
+             mesh.n_vertices());
+    for (std::size_t v = 0; v < deformed.positions.size(); ++v)
+        mesh.set_point(TriMesh::VertexHandle(static_cast<int>(v)), deformed.positions[v]);
+    if (!mesh.has_face_normals()) mesh.request_face_normals();
+    if (!mesh.has_vertex_normals()) mesh.request_vertex_normals();
+    mesh.update_normals();
+}
+
+bool FaceRig::has_effect(int fap) const {
+    if (fap < 1 || fap > fap::kFapCount) fail("expression: rig: no FAP {}", fap);
+    return no_effect_[fap - 1].empty();
+}
+
+const std::string& FaceRig::why_no_effect(int fap) const {
+    if (fap < 1 || fap > fap::kFapCount) fail("expression: rig: no FAP {}", fap);
+    return no_effect_[fap - 1];
+}
+
+double FaceRig::influence_radius(int feature_point) const {
+    const int j = system_of_fp_.at(feature_point);
+    return j < 0 ? 0.0 : system_radius_[j];
+}
+
+}  // namespace emoface::expression
