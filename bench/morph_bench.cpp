@@ -65,6 +65,8 @@ struct Row {
     std::string backend;
     double ms = NAN;         // per frame, median (batched on CUDA)
     double single_ms = NAN;  // CUDA: one frame alone, median
+    double graph_ms = NAN;   // CUDA: per frame, a captured batch replayed as a graph (no host work), median
+    double host_us = NAN;    // CUDA: host time to validate, build and enqueue one frame, median
     int batch = 1;
     int runs = 0;
     double err_max = NAN, err_p999 = NAN;  // fast: source position error, pixels
@@ -116,13 +118,14 @@ public:
         s << "command: `" << command << "`\n\n";
         s << "device: " << morph::cuda_device_description() << "; host threads: "
           << std::max(1u, std::thread::hardware_concurrency()) << "\n\n";
-        s << "| size | N | K | backend | ms/frame | single frame ms | batch | runs | G px-lines/s | x thesis | "
-             "fast max err px | fast p99.9 err px |\n";
-        s << "|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+        s << "| size | N | K | backend | ms/frame | single frame ms | graph ms/frame | host µs/frame | batch | runs | "
+             "G px-lines/s | x thesis | fast max err px | fast p99.9 err px |\n";
+        s << "|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
         for (const Row& r : rows_) {
             const double thesis = thesis_ms(r);
             s << "| " << r.size << "² | " << r.lines << " | " << r.keys << " | " << r.backend << " | "
-              << fmt(r.ms, 4) << " | " << fmt(r.single_ms, 4) << " | " << r.batch << " | " << r.runs << " | "
+              << fmt(r.ms, 4) << " | " << fmt(r.single_ms, 4) << " | " << fmt(r.graph_ms, 4) << " | "
+              << fmt(r.host_us, 1) << " | " << r.batch << " | " << r.runs << " | "
               << fmt(r.gpl(), 1) << " | " << (std::isnan(thesis) || r.backend == "thesis" ? "-" : fmt(thesis / r.ms, 1))
               << " | " << fmt(r.err_max, 3) << " | " << fmt(r.err_p999, 3) << " |\n";
         }
@@ -158,8 +161,11 @@ private:
 
     void add(const Row& r) {
         rows_.push_back(r);
-        std::fprintf(stderr, "  %5d² N=%3d K=%d %-22s %10.4f ms/frame (single %8.4f, batch %d, runs %d) %8.1f G px-lines/s",
-                     r.size, r.lines, r.keys, r.backend.c_str(), r.ms, r.single_ms, r.batch, r.runs, r.gpl());
+        std::fprintf(stderr,
+                     "  %5d² N=%3d K=%d %-22s %10.4f ms/frame (single %8.4f, graph %8.4f, host %6.1f us, batch %d, "
+                     "runs %d) %8.1f G px-lines/s",
+                     r.size, r.lines, r.keys, r.backend.c_str(), r.ms, r.single_ms, r.graph_ms, r.host_us, r.batch,
+                     r.runs, r.gpl());
         if (!std::isnan(r.err_max)) std::fprintf(stderr, "  err max %.3f p99.9 %.3f px", r.err_max, r.err_p999);
         std::fprintf(stderr, "\n");
     }
@@ -299,10 +305,30 @@ private:
         // Back-to-back frames hide the launch and host work behind the GPU:
         // batches of about 2 ms of frames.
         r.batch = std::clamp(static_cast<int>(2.0 / r.single_ms), 1, 64);
-        std::vector<double> batched;
-        for (int i = 0; i < o_.runs; ++i) batched.push_back(timed(i % sets, r.batch));
+        std::vector<double> batched, host;
+        for (int i = 0; i < o_.runs; ++i) {
+            const auto t0 = Clock::now();
+            batched.push_back(timed(i % sets, r.batch));
+            host.push_back(std::chrono::duration<double, std::micro>(Clock::now() - t0).count() / r.batch);
+        }
         r.ms = r.batch == 1 ? r.single_ms : median(batched);
         r.runs = o_.runs;
+        // Host time: the batch's wall time is the larger of host enqueue and
+        // GPU time, so time the enqueue alone on frames the GPU has finished.
+        {
+            std::vector<double> host_times;
+            for (int i = 0; i < o_.runs; ++i) {
+                const int set = i % sets;
+                const auto t0 = Clock::now();
+                enqueue(set);
+                host_times.push_back(std::chrono::duration<double, std::micro>(Clock::now() - t0).count());
+                m[set]->synchronize();
+            }
+            r.host_us = median(host_times);
+        }
+        // The same frames captured once into a CUDA graph and replayed: the
+        // GPU's time per frame without host work or launch gaps.
+        r.graph_ms = graph_time(*m[0], [&] { enqueue(0); }, r.batch, e0, e1);
         if (acc == Accuracy::Fast && size <= o_.error_max_size)
             position_error(*m[0], inputs[0].targets[0], params, r.err_max, r.err_p999);
         add(r);
@@ -317,6 +343,36 @@ private:
             st.free_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count() / sets;
             stages_[{config, "emoface cuda exact"}] = st;
         }
+    }
+
+    // Per-frame GPU time of `batch` frames captured into a graph, or NaN
+    // where capture is not possible.
+    template <class Enqueue>
+    double graph_time(Morpher& m, Enqueue enqueue, int batch, cudaEvent_t e0, cudaEvent_t e1) {
+        auto stream = static_cast<cudaStream_t>(m.cuda_stream());
+        cudaGraph_t graph = nullptr;
+        cudaGraphExec_t exec = nullptr;
+        if (cudaStreamBeginCapture(stream, cudaStreamCaptureModeRelaxed) != cudaSuccess) return NAN;
+        bool ok = true;
+        try {
+            for (int b = 0; b < batch; ++b) enqueue();
+        } catch (const std::exception&) {
+            ok = false;
+        }
+        ok = cudaStreamEndCapture(stream, &graph) == cudaSuccess && ok;
+        ok = ok && cudaGraphInstantiate(&exec, graph, 0) == cudaSuccess;
+        std::vector<double> t;
+        for (int i = 0; ok && i < o_.runs + 3; ++i) {
+            ok = cudaEventRecord(e0, stream) == cudaSuccess && cudaGraphLaunch(exec, stream) == cudaSuccess &&
+                 cudaEventRecord(e1, stream) == cudaSuccess && cudaEventSynchronize(e1) == cudaSuccess;
+            float ms = 0.0f;
+            ok = ok && cudaEventElapsedTime(&ms, e0, e1) == cudaSuccess;
+            if (i >= 3) t.push_back(static_cast<double>(ms) / batch);
+        }
+        if (exec) cudaGraphExecDestroy(exec);
+        if (graph) cudaGraphDestroy(graph);
+        cudaGetLastError();
+        return ok ? median(t) : NAN;
     }
 
     void run_thesis(int size, int lines, int keys, const bench::InputSet& in, const std::string& config) {

@@ -49,6 +49,9 @@ struct LineTable {
 
 enum class OutKind : int { Pixels, Surface, Displacement, Sums };
 
+// Grid sums are padded to whole float4s so a corner loads with 16-byte loads.
+__host__ __device__ constexpr int sums_stride(int sources) { return (kernel::sum_floats(sources) + 3) / 4 * 4; }
+
 struct KernelArgs {
     const float4* lines;  // device table, or nullptr: the LineTable parameter
     int n_lines;
@@ -169,7 +172,7 @@ __global__ void __launch_bounds__(128) warp_kernel(const __grid_constant__ Kerne
         float dx[K], dy[K];
         kernel::displacement(acc, p, a.extent, dx, dy);
         if (a.out_kind == OutKind::Sums) {
-            float* g = a.sums + (static_cast<std::size_t>(j) * a.points_w + i) * kernel::sum_floats(K);
+            float* g = a.sums + (static_cast<std::size_t>(j) * a.points_w + i) * sums_stride(K);
             g[0] = acc.w[p];
 #pragma unroll
             for (int k = 0; k < K; ++k) {
@@ -205,12 +208,15 @@ __global__ void __launch_bounds__(128) near_kernel(const __grid_constant__ Kerne
 }
 
 // Fast mode, pass 3: four pixels of one row a thread, all in one cell
-// (fast_cell is a multiple of 4): the cell's far sums interpolated, its near
-// lines added exactly (kernel.h, "fast mode"), then texture-unit sampling.
+// (fast_cell is a multiple of 4); a warp covers 32 x 4 pixels, so its loads
+// of grid corners and its texture fetches stay local. The cell's corner sums
+// are interpolated (less the near lines' terms, where it has any), then the
+// near lines are added exactly (kernel.h, "fast mode") and the keys sampled
+// through the texture unit.
 template <int K, Law L>
 __global__ void __launch_bounds__(256) apply_kernel(const __grid_constant__ KernelArgs a,
                                                     const __grid_constant__ LineTable table) {
-    constexpr int S = kernel::sum_floats(K);
+    constexpr int S4 = sums_stride(K) / 4;
     const int x0 = (blockIdx.x * blockDim.x + threadIdx.x) * 4;
     const int y = blockIdx.y * blockDim.y + threadIdx.y;
     if (x0 >= a.width || y >= a.height) return;
@@ -222,27 +228,48 @@ __global__ void __launch_bounds__(256) apply_kernel(const __grid_constant__ Kern
     const unsigned short* list = a.near_list + static_cast<std::size_t>(tile) * kernel::kMaxNear;
     const float inv = a.inv_extent;
     const float xi = (static_cast<float>(x0) + 0.5f) * inv, yi = (static_cast<float>(y) + 0.5f) * inv;
-
-    // The cell's far sums at the two ends of this row segment (left and
-    // right grid columns); then each pixel on its own, to keep registers for
-    // occupancy (this pass waits on memory and the texture unit).
     const bool crowded = count > kernel::kMaxNear;  // every line, exactly
     const float inv_cell = 1.0f / static_cast<float>(a.cell);
-    float left[S], right[S];
+
+    // The two grid columns of the cell, interpolated to this row.
+    float4 left[S4], right[S4];
     if (!crowded) {
         const float fy = static_cast<float>(y - ty * a.cell) * inv_cell;
+        const float4* g00 = reinterpret_cast<const float4*>(a.grid) + (static_cast<std::size_t>(ty) * a.grid_w + tx) * S4;
+        const float4* g01 = g00 + static_cast<std::size_t>(a.grid_w) * S4;
 #pragma unroll
-        for (int side = 0; side < 2; ++side) {
-            const int gx = tx + side;
-            const float cx = (static_cast<float>(gx * a.cell) + 0.5f) * inv;
-            float top[S], bottom[S];
-            kernel::far_sums<K, L>(a.grid + (static_cast<std::size_t>(ty) * a.grid_w + gx) * S, records, rf, list,
-                                   count, cx, (static_cast<float>(ty * a.cell) + 0.5f) * inv, a.b, top);
-            kernel::far_sums<K, L>(a.grid + (static_cast<std::size_t>(ty + 1) * a.grid_w + gx) * S, records, rf,
-                                   list, count, cx, (static_cast<float>((ty + 1) * a.cell) + 0.5f) * inv, a.b,
-                                   bottom);
+        for (int q = 0; q < S4; ++q) {
+            const float4 t0 = __ldg(g00 + q), b0 = __ldg(g01 + q), t1 = __ldg(g00 + S4 + q), b1 = __ldg(g01 + S4 + q);
+            left[q] = make_float4(t0.x + fy * (b0.x - t0.x), t0.y + fy * (b0.y - t0.y), t0.z + fy * (b0.z - t0.z),
+                                  t0.w + fy * (b0.w - t0.w));
+            right[q] = make_float4(t1.x + fy * (b1.x - t1.x), t1.y + fy * (b1.y - t1.y), t1.z + fy * (b1.z - t1.z),
+                                   t1.w + fy * (b1.w - t1.w));
+        }
+        if (count > 0) {  // the grid holds every line: take the near lines' terms out at the corners
+            const float y_top = (static_cast<float>(ty * a.cell) + 0.5f) * inv;
+            const float y_bottom = (static_cast<float>((ty + 1) * a.cell) + 0.5f) * inv;
 #pragma unroll
-            for (int q = 0; q < S; ++q) (side == 0 ? left : right)[q] = top[q] + fy * (bottom[q] - top[q]);
+            for (int side = 0; side < 2; ++side) {
+                const float cx = (static_cast<float>((tx + side) * a.cell) + 0.5f) * inv;
+                Accum<K, 1> top, bottom;
+                top.clear();
+                bottom.clear();
+                for (int n = 0; n < count; ++n) {
+                    const float* rec = records + list[n] * rf;
+                    kernel::accumulate_line<K, 1, L>(rec, cx, y_top, 0.0f, a.b, top);
+                    kernel::accumulate_line<K, 1, L>(rec, cx, y_bottom, 0.0f, a.b, bottom);
+                }
+                float near[4 * S4];
+                near[0] = top.w[0] + fy * (bottom.w[0] - top.w[0]);
+#pragma unroll
+                for (int k = 0; k < K; ++k) {
+                    near[1 + 2 * k] = top.dx[k][0] + fy * (bottom.dx[k][0] - top.dx[k][0]);
+                    near[2 + 2 * k] = top.dy[k][0] + fy * (bottom.dy[k][0] - top.dy[k][0]);
+                }
+                float* col = reinterpret_cast<float*>(side == 0 ? left : right);
+#pragma unroll
+                for (int q = 0; q < kernel::sum_floats(K); ++q) col[q] -= near[q];
+            }
         }
     }
 
@@ -260,11 +287,13 @@ __global__ void __launch_bounds__(256) apply_kernel(const __grid_constant__ Kern
                 kernel::accumulate_line<K, 1, L>(records + l * rf, xp, yi, 0.0f, a.b, acc);
         } else {
             const float fx = static_cast<float>(x - tx * a.cell) * inv_cell;
-            acc.w[0] = left[0] + fx * (right[0] - left[0]);
+            const float* l = reinterpret_cast<const float*>(left);
+            const float* r = reinterpret_cast<const float*>(right);
+            acc.w[0] = l[0] + fx * (r[0] - l[0]);
 #pragma unroll
             for (int k = 0; k < K; ++k) {
-                acc.dx[k][0] = left[1 + 2 * k] + fx * (right[1 + 2 * k] - left[1 + 2 * k]);
-                acc.dy[k][0] = left[2 + 2 * k] + fx * (right[2 + 2 * k] - left[2 + 2 * k]);
+                acc.dx[k][0] = l[1 + 2 * k] + fx * (r[1 + 2 * k] - l[1 + 2 * k]);
+                acc.dy[k][0] = l[2 + 2 * k] + fx * (r[2 + 2 * k] - l[2 + 2 * k]);
             }
             for (int n = 0; n < count; ++n)
                 kernel::accumulate_line<K, 1, L>(records + list[n] * rf, xp, yi, 0.0f, a.b, acc);
@@ -470,7 +499,7 @@ public:
             a.reach = (plan.fast_reach + 0.70711f) * static_cast<float>(cell) * plan.inv_extent;
             const std::size_t tiles = static_cast<std::size_t>(a.tiles_w) * a.tiles_h;
             ensure(grid_, grid_bytes_,
-                   static_cast<std::size_t>(a.grid_w) * grid_h * kernel::sum_floats(plan.sources) * sizeof(float));
+                   static_cast<std::size_t>(a.grid_w) * grid_h * sums_stride(plan.sources) * sizeof(float));
             ensure(near_count_, near_count_bytes_, tiles * sizeof(int));
             ensure(near_list_, near_list_bytes_, tiles * kernel::kMaxNear * sizeof(unsigned short));
             a.near_count = near_count_;
@@ -485,8 +514,8 @@ public:
             near_kernel<<<static_cast<unsigned>((tiles + 127) / 128), 128, 0, stream_>>>(a, table_);
             EMOFACE_CUDA_CHECK(cudaGetLastError());
             a.grid = grid_;
-            const dim3 block(32, 8);
-            const dim3 blocks((width_ + 4 * 32 - 1) / (4 * 32), (height_ + 7) / 8);
+            const dim3 block(8, 32);  // a warp: 8 threads x 4 pixels wide, 4 rows
+            const dim3 blocks((width_ + 4 * 8 - 1) / (4 * 8), (height_ + 31) / 32);
             launch_apply_any(plan.sources, plan.law, blocks, block, stream_, a, table_);
             EMOFACE_CUDA_CHECK(cudaGetLastError());
         }
