@@ -48,25 +48,6 @@ V3 ray_dir(double theta, double phi) {
     return {std::sin(theta) * std::cos(phi), std::sin(phi), std::cos(theta) * std::cos(phi)};
 }
 
-// Samples `count` steps from key a to key b (excluding a, including b).
-detail::RowKey lerp_key(const detail::RowKey& a, const detail::RowKey& b, double t) {
-    detail::RowKey k;
-    k.origin_y = detail::mix(a.origin_y, b.origin_y, t);
-    k.origin_z_front = detail::mix(a.origin_z_front, b.origin_z_front, t);
-    k.origin_z_back = detail::mix(a.origin_z_back, b.origin_z_back, t);
-    k.angle_front_deg = detail::mix(a.angle_front_deg, b.angle_front_deg, t);
-    k.angle_back_deg = detail::mix(a.angle_back_deg, b.angle_back_deg, t);
-    return k;
-}
-
-Row to_row(const detail::RowKey& k) {
-    return {k.origin_y, k.origin_z_front, k.origin_z_back, k.angle_front_deg * kDeg, k.angle_back_deg * kDeg};
-}
-
-void sweep(const detail::RowKey& a, const detail::RowKey& b, int count, std::vector<Row>& out) {
-    for (int s = 1; s <= count; ++s) out.push_back(to_row(lerp_key(a, b, static_cast<double>(s) / count)));
-}
-
 int scaled(int n, double scale, int minimum) {
     return std::max(minimum, static_cast<int>(std::lround(n * scale)));
 }
@@ -814,8 +795,9 @@ Face Generator::build(int texture_size) {
     face.mesh.request_face_normals();
     face.mesh.update_normals();
     // The seam at the back of the head doubles a column for the texture; give
-    // both copies the same normal so shading does not show it.
+    // both copies the same normal so shading does not show it, and weld them.
     for (int j = 0; j < static_cast<int>(rows_.size()); ++j) {
+        face.welded.push_back({grid(0, j), grid(ncols_, j)});
         const TriMesh::VertexHandle a(grid(0, j)), b(grid(ncols_, j));
         auto n = face.mesh.normal(a) + face.mesh.normal(b);
         const float l = n.norm();

@@ -5,13 +5,17 @@
 
 namespace emoface::expression::detail {
 
-GeodesicGraph::GeodesicGraph(const TriMesh& mesh) {
+GeodesicGraph::GeodesicGraph(const TriMesh& mesh, const std::vector<std::array<int, 2>>& welded) {
     const int n = static_cast<int>(mesh.n_vertices());
     start_.assign(n + 1, 0);
     for (auto eh : mesh.edges()) {
         const auto h = mesh.halfedge_handle(eh, 0);
         ++start_[mesh.from_vertex_handle(h).idx() + 1];
         ++start_[mesh.to_vertex_handle(h).idx() + 1];
+    }
+    for (const auto& w : welded) {
+        ++start_[w[0] + 1];
+        ++start_[w[1] + 1];
     }
     for (int v = 0; v < n; ++v) start_[v + 1] += start_[v];
     neighbour_.resize(start_[n]);
@@ -25,6 +29,12 @@ GeodesicGraph::GeodesicGraph(const TriMesh& mesh) {
         length_[fill[a]++] = l;
         neighbour_[fill[b]] = a;
         length_[fill[b]++] = l;
+    }
+    for (const auto& w : welded) {
+        neighbour_[fill[w[0]]] = w[1];
+        length_[fill[w[0]]++] = 0.0;
+        neighbour_[fill[w[1]]] = w[0];
+        length_[fill[w[1]]++] = 0.0;
     }
     dist_.assign(n, std::numeric_limits<double>::infinity());
 }

@@ -223,7 +223,7 @@ void FaceRig::build_point_field(const Face& face, double radius_scale) {
     // weight for "no motion" makes the field fade to 0 away from all points.
     // Weights are a convex combination, so nothing overshoots.
     constexpr double kBackground = 0.15;
-    detail::GeodesicGraph graph(face.mesh);
+    detail::GeodesicGraph graph(face.mesh, face.welded);
     std::vector<std::vector<std::pair<int, double>>> reach(n);  // (entry, distance)
     for (std::size_t j = 0; j < entries.size(); ++j)
         for (auto [v, g] : graph.within(entries[j].sources, entries[j].radius))
@@ -313,7 +313,7 @@ void FaceRig::build_jaw(const Face& face) {
 
     // Which side of the mouth a vertex is on, by distance along the skin:
     // across the closed lips the two sides are far apart.
-    detail::GeodesicGraph graph(face.mesh);
+    detail::GeodesicGraph graph(face.mesh, face.welded);
     auto sources = [&](std::initializer_list<const char*> ids) {
         std::vector<int> s;
         for (const char* id : ids)

@@ -105,6 +105,13 @@ struct Face {
     // Base colour (skin, lips, brows, eyes, mouth interior) addressed by the
     // mesh's texcoords; empty for an imported face without a texture.
     Image base_colour;
+    // For a face loaded from files: the base-colour image its FDP names
+    // (absolute path, "" if none); the renderer loads it.
+    std::string base_colour_file;
+    // Pairs of vertices that are one point of the surface, split only so
+    // each can carry its own texture coordinate (UV seams). The rig moves
+    // them alike; the default face's eye and mouth slits are NOT welded.
+    std::vector<std::array<int, 2>> welded;
 
     int vertex_count() const { return static_cast<int>(mesh.n_vertices()); }
     bool has(int feature_point) const { return feature_points.at(feature_point).present; }
@@ -125,6 +132,15 @@ void update_fapu(Face& face);
 // in range, eyeball ranges inside the mesh); throws emoface::InputError with
 // `context` in the message otherwise.
 void validate_face(const Face& face, const std::string& context);
+
+// Sets jaw_pivot and head_pivot from the feature points, for faces that do
+// not give them (Candide-3, an FDP without pivots): the jaw pivot behind the
+// outer eye corners at the height between the eyes and the nose base, the
+// head pivot (7.1 when present) below and behind it.
+void estimate_pivots(Face& face);
+
+// The face's texture box around its skin in frontal projection, with a margin.
+TextureBox frontal_box(const Face& face);
 
 // Feature points the face lacks, as ids ("6.1", ...), in table order.
 std::vector<std::string> missing_feature_points(const Face& face);
