@@ -48,6 +48,20 @@ V3 ray_dir(double theta, double phi) {
     return {std::sin(theta) * std::cos(phi), std::sin(phi), std::cos(theta) * std::cos(phi)};
 }
 
+detail::RowKey lerp_key(const detail::RowKey& a, const detail::RowKey& b, double t) {
+    detail::RowKey k;
+    k.origin_y = detail::mix(a.origin_y, b.origin_y, t);
+    k.origin_z_front = detail::mix(a.origin_z_front, b.origin_z_front, t);
+    k.origin_z_back = detail::mix(a.origin_z_back, b.origin_z_back, t);
+    k.angle_front_deg = detail::mix(a.angle_front_deg, b.angle_front_deg, t);
+    k.angle_back_deg = detail::mix(a.angle_back_deg, b.angle_back_deg, t);
+    return k;
+}
+
+Row to_row(const detail::RowKey& k) {
+    return {k.origin_y, k.origin_z_front, k.origin_z_back, k.angle_front_deg * kDeg, k.angle_back_deg * kDeg};
+}
+
 int scaled(int n, double scale, int minimum) {
     return std::max(minimum, static_cast<int>(std::lround(n * scale)));
 }
