@@ -124,6 +124,7 @@ void fence() {
 int main(int argc, char** argv) {
     CLI::App app{"emoface end-to-end frame benchmark (FAP sample to fenced draw)"};
     std::string data_dir = EMOFACE_DATA_DIR, fap_path, save, compare, backend_name = "auto";
+    std::string frames_name = "mesh";
     int frames = 500, warmup = 30, map_size = 2048, width = 1920, height = 1080, samples = 4;
     int check_frame = 25;
     double face_scale = 1.0, min_psnr = 30.0;
@@ -137,6 +138,9 @@ int main(int argc, char** argv) {
     app.add_option("--samples", samples, "MSAA samples")->check(CLI::Range(1, 16));
     app.add_option("--face-scale", face_scale, "default face mesh resolution scale")->check(CLI::Range(0.1, 2.0));
     app.add_option("--backend", backend_name, "morph backend: auto, cpu, cuda");
+    app.add_option("--tangents", frames_name,
+                   "wrinkle UVs and tangent frames: mesh (CPU, uploaded) or shader (closed form)")
+        ->check(CLI::IsMember({"mesh", "shader"}));
     app.add_option("--check-frame", check_frame, "stream frame saved or compared");
     app.add_option("--save", save, "write the check frame as PPM (the reference, on the CPU)");
     app.add_option("--compare", compare, "PPM reference to compare the check frame with");
@@ -178,6 +182,7 @@ int main(int argc, char** argv) {
         render::HeadlessPlatform platform(po);
         render::FaceSceneOptions so;
         so.backend = backend;
+        so.frames = frames_name == "shader" ? render::WrinkleFrames::Shader : render::WrinkleFrames::Mesh;
         t = Clock::now();
         render::FaceScene scene(platform, face, rig, keys, lines, so);
         const double scene_ms = ms(Clock::now() - t);
@@ -188,6 +193,8 @@ int main(int argc, char** argv) {
                     morph::to_string(scene.morpher().backend()),
                     morph::cuda_device_description().c_str(), scene.key_count(), map_size,
                     map_size, lines.size(), scene.uses_interop() ? "yes" : "no");
+        std::printf("  wrinkle UVs and tangent frames: %s\n",
+                    frames_name == "shader" ? "vertex shader (closed form)" : "CPU (TangentFrames), uploaded");
         std::printf("  face: %zu vertices, %zu triangles; frame %dx%d, %d samples; FAP %s, %zu frames at %g fps\n",
                     face.mesh.n_vertices(), face.mesh.n_faces(), width, height, platform.samples(),
                     fap_path.c_str(), stream.frames.size(), stream.fps);

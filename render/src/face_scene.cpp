@@ -105,7 +105,7 @@ FaceScene::FaceScene(Platform& platform, const expression::Face& face,
                      const expression::FaceRig& rig, std::vector<WrinkleKey> keys,
                      std::vector<expression::FeatureLine> lines, const FaceSceneOptions& options)
     : platform_(platform), face_(face), rig_(rig), box_(layout_box(face)), lines_(std::move(lines)),
-      params_(options.morph) {
+      params_(options.morph), frames_(options.frames) {
     params_.normal_map = true;
     if (keys.empty()) fail<InputError>("render: FaceScene: no wrinkle keys");
     if (lines_.empty()) fail<InputError>("render: FaceScene: no feature lines");
@@ -184,8 +184,11 @@ FaceScene::FaceScene(Platform& platform, const expression::Face& face,
         }
         part.wrinkles = m.uses_wrinkle_map;
         part.wrinkle_uvs.assign(part.full_index.size(), glm::vec2(0.0f));
-        if (!part.wrinkles) part.fixed_tangents.assign(part.full_index.size(), glm::vec4(1, 0, 0, 1));
+        part.fixed_tangents.assign(part.full_index.size(), glm::vec4(1, 0, 0, 1));
         part.id = renderer_->add_mesh(part.mesh, m);
+        // Parts the CPU gives no frames to: constant ones, uploaded once.
+        if (!part.wrinkles || frames_ == WrinkleFrames::Shader)
+            renderer_->update_mesh(part.id, part.mesh, part.wrinkle_uvs, part.fixed_tangents);
     }
 
     // Start at the neutral pose with the first key alone.
@@ -230,30 +233,42 @@ void FaceScene::update_geometry(const expression::FapValues& faps) {
     times_.layout_ms = ms_since(t);
 
     times_.uv_ms = times_.tangents_ms = times_.upload_ms = 0.0;
+    const auto* full_points = mesh_.points();
+    const auto* full_normals = mesh_.vertex_normals();
     for (Part& part : parts_) {
         if (part.id < 0) continue;
         t = Clock::now();
+        auto& points = part.mesh.property(part.mesh.points_pph()).data_vector();
+        auto& normals = part.mesh.property(part.mesh.vertex_normals_pph()).data_vector();
+        const bool cpu_frames = part.wrinkles && frames_ == WrinkleFrames::Mesh;
         for (std::size_t i = 0; i < part.full_index.size(); ++i) {
-            const auto full = mesh_.vertex_handle(part.full_index[i]);
-            const auto vh = part.mesh.vertex_handle(int(i));
-            const auto& p = mesh_.point(full);
-            part.mesh.set_point(vh, p);
-            part.mesh.set_normal(vh, mesh_.normal(full));
-            if (part.wrinkles)
+            const auto& p = full_points[part.full_index[i]];
+            points[i] = p;
+            normals[i] = full_normals[part.full_index[i]];
+            if (cpu_frames)
                 part.wrinkle_uvs[i] = expression::project_to_texture(glm::vec3(p[0], p[1], p[2]), box_);
         }
         times_.uv_ms += ms_since(t);
         t = Clock::now();
-        if (part.wrinkles) part.frames.compute(part.mesh, part.wrinkle_uvs);
+        if (cpu_frames) part.frames.compute(part.mesh, part.wrinkle_uvs);
         times_.tangents_ms += ms_since(t);
         t = Clock::now();
-        renderer_->update_mesh(part.id, part.mesh, part.wrinkle_uvs,
-                               part.wrinkles ? part.frames.tangents() : part.fixed_tangents);
+        if (cpu_frames)
+            renderer_->update_mesh(part.id, part.mesh, part.wrinkle_uvs, part.frames.tangents());
+        else
+            renderer_->update_shape(part.id, part.mesh);
         times_.upload_ms += ms_since(t);
     }
 }
 
 void FaceScene::draw(const DrawOptions& options) {
+    if (frames_ == WrinkleFrames::Shader) {
+        DrawOptions o = options;
+        o.projective_wrinkles = true;
+        o.projective_box = {box_.min.x, box_.min.y, box_.max.x, box_.max.y};
+        renderer_->draw(o, texture_.get());
+        return;
+    }
     renderer_->draw(options, texture_.get());
 }
 

@@ -43,14 +43,18 @@ Camera Camera::frontal(const glm::vec3& box_min, const glm::vec3& box_max, float
 
 namespace {
 
-// Per-vertex data that changes every frame, interleaved.
-struct DynamicVertex {
+// Per-vertex data that changes every frame, in two buffers: the shape, and
+// the wrinkle map's frame (not needed when the shader derives it).
+struct ShapeVertex {
     float position[3];
     float normal[3];
+};
+struct FrameVertex {
     float tangent[4];
     float wrinkle_uv[2];
 };
-static_assert(sizeof(DynamicVertex) == 12 * sizeof(float), "tightly packed");
+static_assert(sizeof(ShapeVertex) == 6 * sizeof(float), "tightly packed");
+static_assert(sizeof(FrameVertex) == 6 * sizeof(float), "tightly packed");
 
 GLuint compile(GLenum stage, const char* source) {
     GLuint s = glCreateShader(stage);
@@ -129,12 +133,13 @@ struct Renderer::Impl {
     struct Mesh {
         Material material;
         GLuint base_texture = 0;
-        GLuint vao = 0, dynamic_vbo = 0, static_vbo = 0, ebo = 0;
+        GLuint vao = 0, shape_vbo = 0, frame_vbo = 0, static_vbo = 0, ebo = 0;
         GLsizei index_count = 0;
         std::size_t vertex_count = 0;
         std::vector<glm::vec2> base_uvs;
         TangentFrames frames;
-        std::vector<DynamicVertex> staging;
+        std::vector<ShapeVertex> shape_staging;
+        std::vector<FrameVertex> frame_staging;
     };
 
     Platform& platform;
@@ -142,7 +147,8 @@ struct Renderer::Impl {
     struct {
         GLint model, normal_matrix, view_projection, base_map, has_base_map, base_color,
             wrinkle_map, use_wrinkle_map, wrinkle_signed, light_position, light_ambient,
-            light_diffuse, light_specular, specular_color, shininess, camera_position;
+            light_diffuse, light_specular, specular_color, shininess, camera_position, projective,
+            box;
     } loc{};
     std::vector<Mesh> meshes;
 
@@ -156,10 +162,10 @@ struct Renderer::Impl {
 
     void release(Mesh& m) {
         if (m.base_texture) glDeleteTextures(1, &m.base_texture);
-        const GLuint buffers[3] = {m.dynamic_vbo, m.static_vbo, m.ebo};
-        glDeleteBuffers(3, buffers);
+        const GLuint buffers[4] = {m.shape_vbo, m.frame_vbo, m.static_vbo, m.ebo};
+        glDeleteBuffers(4, buffers);
         if (m.vao) glDeleteVertexArrays(1, &m.vao);
-        m.base_texture = m.vao = m.dynamic_vbo = m.static_vbo = m.ebo = 0;
+        m.base_texture = m.vao = m.shape_vbo = m.frame_vbo = m.static_vbo = m.ebo = 0;
     }
 };
 
@@ -185,6 +191,8 @@ Renderer::Renderer(Platform& platform) : impl_(std::make_unique<Impl>(platform))
     l.specular_color = u("u_specular_color");
     l.shininess = u("u_shininess");
     l.camera_position = u("u_camera_position");
+    l.projective = u("u_projective");
+    l.box = u("u_box");
     check_gl("Renderer: creating the program");
 }
 
@@ -230,26 +238,29 @@ Renderer::MeshId Renderer::add_mesh(const expression::TriMesh& mesh, const Mater
         }
 
     glGenVertexArrays(1, &m.vao);
-    glGenBuffers(1, &m.dynamic_vbo);
+    glGenBuffers(1, &m.shape_vbo);
+    glGenBuffers(1, &m.frame_vbo);
     glGenBuffers(1, &m.static_vbo);
     glGenBuffers(1, &m.ebo);
     glBindVertexArray(m.vao);
-    glBindBuffer(GL_ARRAY_BUFFER, m.dynamic_vbo);
-    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(m.vertex_count * sizeof(DynamicVertex)), nullptr,
+    glBindBuffer(GL_ARRAY_BUFFER, m.shape_vbo);
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(m.vertex_count * sizeof(ShapeVertex)), nullptr,
                  GL_DYNAMIC_DRAW);
-    const auto stride = GLsizei(sizeof(DynamicVertex));
     glEnableVertexAttribArray(0);
-    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, stride,
-                          reinterpret_cast<void*>(offsetof(DynamicVertex, position)));
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, GLsizei(sizeof(ShapeVertex)),
+                          reinterpret_cast<void*>(offsetof(ShapeVertex, position)));
     glEnableVertexAttribArray(1);
-    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, stride,
-                          reinterpret_cast<void*>(offsetof(DynamicVertex, normal)));
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, GLsizei(sizeof(ShapeVertex)),
+                          reinterpret_cast<void*>(offsetof(ShapeVertex, normal)));
+    glBindBuffer(GL_ARRAY_BUFFER, m.frame_vbo);
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(m.vertex_count * sizeof(FrameVertex)), nullptr,
+                 GL_DYNAMIC_DRAW);
     glEnableVertexAttribArray(2);
-    glVertexAttribPointer(2, 4, GL_FLOAT, GL_FALSE, stride,
-                          reinterpret_cast<void*>(offsetof(DynamicVertex, tangent)));
+    glVertexAttribPointer(2, 4, GL_FLOAT, GL_FALSE, GLsizei(sizeof(FrameVertex)),
+                          reinterpret_cast<void*>(offsetof(FrameVertex, tangent)));
     glEnableVertexAttribArray(3);
-    glVertexAttribPointer(3, 2, GL_FLOAT, GL_FALSE, stride,
-                          reinterpret_cast<void*>(offsetof(DynamicVertex, wrinkle_uv)));
+    glVertexAttribPointer(3, 2, GL_FLOAT, GL_FALSE, GLsizei(sizeof(FrameVertex)),
+                          reinterpret_cast<void*>(offsetof(FrameVertex, wrinkle_uv)));
     glBindBuffer(GL_ARRAY_BUFFER, m.static_vbo);
     glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(m.vertex_count * sizeof(glm::vec2)),
                  m.base_uvs.data(), GL_STATIC_DRAW);
@@ -309,22 +320,43 @@ void Renderer::update_mesh(MeshId id, const expression::TriMesh& mesh,
              uvs.size(), tangents.size(), n);
     if (!mesh.has_vertex_normals())
         fail("render: Renderer::update_mesh(): the mesh has no vertex normals");
-    m.staging.resize(n);
-    for (const auto vh : mesh.vertices()) {
-        const std::size_t i = std::size_t(vh.idx());
-        const auto& p = mesh.point(vh);
-        const auto& nn = mesh.normal(vh);
-        DynamicVertex& d = m.staging[i];
-        d.position[0] = p[0]; d.position[1] = p[1]; d.position[2] = p[2];
-        d.normal[0] = nn[0]; d.normal[1] = nn[1]; d.normal[2] = nn[2];
+    m.frame_staging.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        FrameVertex& d = m.frame_staging[i];
         d.tangent[0] = tangents[i].x; d.tangent[1] = tangents[i].y;
         d.tangent[2] = tangents[i].z; d.tangent[3] = tangents[i].w;
         d.wrinkle_uv[0] = uvs[i].x; d.wrinkle_uv[1] = uvs[i].y;
     }
-    glBindBuffer(GL_ARRAY_BUFFER, m.dynamic_vbo);
-    glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(n * sizeof(DynamicVertex)), m.staging.data());
+    glBindBuffer(GL_ARRAY_BUFFER, m.frame_vbo);
+    glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(n * sizeof(FrameVertex)),
+                    m.frame_staging.data());
     glBindBuffer(GL_ARRAY_BUFFER, 0);
+    update_shape(id, mesh);
     check_gl("Renderer::update_mesh()");
+}
+
+void Renderer::update_shape(MeshId id, const expression::TriMesh& mesh) {
+    impl_->platform.make_current();
+    Impl::Mesh& m = impl_->mesh(id);
+    const std::size_t n = mesh.n_vertices();
+    if (n != m.vertex_count)
+        fail("render: Renderer::update_shape(): mesh {} had {} vertices, now {}", id,
+             m.vertex_count, n);
+    if (!mesh.has_vertex_normals())
+        fail("render: Renderer::update_shape(): the mesh has no vertex normals");
+    const auto* points = mesh.points();
+    const auto* normals = mesh.vertex_normals();
+    m.shape_staging.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        ShapeVertex& d = m.shape_staging[i];
+        d.position[0] = points[i][0]; d.position[1] = points[i][1]; d.position[2] = points[i][2];
+        d.normal[0] = normals[i][0]; d.normal[1] = normals[i][1]; d.normal[2] = normals[i][2];
+    }
+    glBindBuffer(GL_ARRAY_BUFFER, m.shape_vbo);
+    glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(n * sizeof(ShapeVertex)),
+                    m.shape_staging.data());
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
+    check_gl("Renderer::update_shape()");
 }
 
 void Renderer::draw(const DrawOptions& o, const WrinkleTexture* wrinkle_map) {
@@ -360,6 +392,12 @@ void Renderer::draw(const DrawOptions& o, const WrinkleTexture* wrinkle_map) {
     glUniform3fv(im.loc.light_diffuse, 1, glm::value_ptr(o.light.diffuse));
     glUniform3fv(im.loc.light_specular, 1, glm::value_ptr(o.light.specular));
     glUniform3fv(im.loc.camera_position, 1, glm::value_ptr(o.camera.position));
+    glUniform1i(im.loc.projective, o.projective_wrinkles ? 1 : 0);
+    glUniform4fv(im.loc.box, 1, o.projective_box.data());
+    if (o.projective_wrinkles &&
+        !(o.projective_box[2] > o.projective_box[0] && o.projective_box[3] > o.projective_box[1]))
+        fail("render: Renderer::draw(): empty projective box ({}, {})-({}, {})",
+             o.projective_box[0], o.projective_box[1], o.projective_box[2], o.projective_box[3]);
     glUniform1i(im.loc.base_map, 0);
     glUniform1i(im.loc.wrinkle_map, 1);
     glActiveTexture(GL_TEXTURE1);

@@ -16,6 +16,12 @@ layout(location = 4) in vec2 a_base_uv;      // the mesh's own UVs
 uniform mat4 u_model;
 uniform mat3 u_normal_matrix;
 uniform mat4 u_view_projection;
+// Projective wrinkle layout (DESIGN.md "Texture layouts"): the wrinkle UVs
+// are the model-space position projected frontally into the texture box
+// (min.x, min.y, max.x, max.y), v down; the tangent frame of that map is then
+// known in closed form, so neither is computed on the CPU.
+uniform bool u_projective;
+uniform vec4 u_box;
 
 out vec3 v_position;
 out vec3 v_normal;
@@ -27,8 +33,20 @@ void main() {
     vec4 world = u_model * vec4(a_position, 1.0);
     v_position = world.xyz;
     v_normal = u_normal_matrix * a_normal;
-    v_tangent = vec4(mat3(u_model) * a_tangent.xyz, a_tangent.w);
-    v_wrinkle_uv = a_wrinkle_uv;
+    vec4 tangent = a_tangent;
+    vec2 wrinkle_uv = a_wrinkle_uv;
+    if (u_projective) {
+        wrinkle_uv = vec2((a_position.x - u_box.x) / (u_box.z - u_box.x),
+                          (u_box.w - a_position.y) / (u_box.w - u_box.y));
+        // dp/du on the surface is perpendicular to y (v stays put) and to the
+        // normal: along y x n, signed to point to +x; dp/dv points down, so
+        // the frame is left-handed (w = -1) where the surface faces +z.
+        float s = a_normal.z < 0.0 ? -1.0 : 1.0;
+        vec3 t = s * vec3(a_normal.z, 0.0, -a_normal.x);
+        tangent = dot(t, t) > 1e-12 ? vec4(normalize(t), -s) : vec4(1.0, 0.0, 0.0, -s);
+    }
+    v_tangent = vec4(mat3(u_model) * tangent.xyz, tangent.w);
+    v_wrinkle_uv = wrinkle_uv;
     v_base_uv = a_base_uv;
     gl_Position = u_view_projection * world;
 }

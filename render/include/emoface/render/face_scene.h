@@ -48,8 +48,19 @@ WrinkleKey make_wrinkle_key(const expression::Face& face, const expression::Face
                             const expression::WrinkleLibrarySpec& spec, expression::WrinkleKey key,
                             const expression::FapValues& pose, int size);
 
+// Where the skin's wrinkle UVs and tangent frames come from each frame.
+enum class WrinkleFrames {
+    // Projected and computed on the CPU (TangentFrames on the deformed mesh)
+    // and uploaded: works for any UV set.
+    Mesh,
+    // Derived in the vertex shader from the position and normal: the
+    // projective layout's UVs and their tangent frames have a closed form.
+    Shader,
+};
+
 struct FaceSceneOptions {
     morph::Backend backend = morph::Backend::Auto;
+    WrinkleFrames frames = WrinkleFrames::Mesh;
     // Beier-Neely parameters; normal_map is always set (the keys are normal maps).
     morph::MorphParams morph{};
     Material skin{};  // base_texture: the face's base colour unless set
@@ -124,6 +135,7 @@ private:
     std::unique_ptr<morph::Morpher> morpher_;
     std::unique_ptr<WrinkleMorph> wrinkle_morph_;
     morph::MorphParams params_;
+    WrinkleFrames frames_;
     FrameStageTimes times_;
 };
 

@@ -78,6 +78,13 @@ struct DrawOptions {
     // Viewport in pixels of the bound framebuffer; zero size = the whole
     // framebuffer of the platform given to the renderer.
     std::array<int, 4> viewport{0, 0, 0, 0};
+    // Projective wrinkle layout done on the GPU: when set, bump-mapped meshes
+    // take their wrinkle UVs from their model-space position projected into
+    // this box (min.x, min.y, max.x, max.y; u to +x, v down from max.y) and
+    // their tangent frames in closed form from the normal, instead of the
+    // uploaded UVs and tangents (update_shape() then suffices per frame).
+    bool projective_wrinkles = false;
+    std::array<float, 4> projective_box{0.0f, 0.0f, 1.0f, 1.0f};
 };
 
 // How the wrinkle map's texels hold the tangent-space normal.
@@ -109,6 +116,10 @@ public:
     void update_mesh(MeshId id, const expression::TriMesh& mesh,
                      const std::vector<glm::vec2>& wrinkle_uvs,
                      const std::vector<glm::vec4>& tangents);
+
+    // Only the shape (points, vertex normals): for meshes drawn with
+    // DrawOptions::projective_wrinkles, or whose UVs and tangents stay.
+    void update_shape(MeshId id, const expression::TriMesh& mesh);
 
     void set_material(MeshId id, const Material& material);
     std::size_t mesh_count() const;
