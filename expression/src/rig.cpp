@@ -217,12 +217,15 @@ void FaceRig::build_point_field(const Face& face, double radius_scale) {
     system_held_.clear();
     for (const Entry& e : entries) system_held_.push_back(e.held);
 
-    // Shepard interpolation with compact support: weight ((R - g) / g)^2 of
-    // geodesic distance g, infinite at a feature point (which so moves
-    // exactly by its own displacement) and 0 at R; a constant background
-    // weight for "no motion" makes the field fade to 0 away from all points.
-    // Weights are a convex combination, so nothing overshoots.
+    // Shepard interpolation with compact support. Weight W0 s / (1 - s) of
+    // s = falloff(g / R) for geodesic distance g: infinite at a feature point
+    // (which so moves exactly by its own displacement), 0 from R on; with the
+    // background weight W0 for "no motion", one point alone moves the skin
+    // around it by exactly s (a plateau, then a smooth fall to 0 at R, gentle
+    // enough that large FAPs do not fold the skin). Weights form a convex
+    // combination, so nothing overshoots.
     constexpr double kBackground = 0.15;
+    auto falloff = [](double t) { return 1.0 - smoothstep(0.2, 1.0, t); };
     detail::GeodesicGraph graph(face.mesh, face.welded);
     std::vector<std::vector<std::pair<int, double>>> reach(n);  // (entry, distance)
     for (std::size_t j = 0; j < entries.size(); ++j)
@@ -238,8 +241,8 @@ void FaceRig::build_point_field(const Face& face, double radius_scale) {
         for (std::size_t q = 0; q < reach[v].size(); ++q) {
             const auto [j, g] = reach[v][q];
             if (g <= 1e-9) at = j;
-            const double r = entries[j].radius;
-            w[q] = g > 1e-9 ? ((r - g) / g) * ((r - g) / g) : 0.0;
+            const double sv = falloff(g / entries[j].radius);
+            w[q] = g > 1e-9 && sv < 1.0 ? kBackground * sv / (1.0 - sv) : (g > 1e-9 ? 1e12 : 0.0);
             total += w[q];
         }
         if (at >= 0) {
@@ -309,7 +312,7 @@ void FaceRig::build_jaw(const Face& face) {
     const double y_mid = 0.5 * (p22[1] + p23[1]), y_corner = 0.5 * (pl[1] + pr[1]);
     const double z_corner = 0.5 * (pl[2] + pr[2]);
     const V P = jaw_pivot_;
-    const double delta = 0.16 * es0;
+    const double delta = 0.25 * es0;
 
     // Which side of the mouth a vertex is on, by distance along the skin:
     // across the closed lips the two sides are far apart.
@@ -337,12 +340,14 @@ void FaceRig::build_jaw(const Face& face) {
         }
         double w = smoothstep(delta, -delta, y - line);
         if (to_upper[v] < 1e29 || to_lower[v] < 1e29) {
-            const double lip = 1.0 - smoothstep(0.8 * half_width, 1.05 * half_width, std::abs(x - mx));
+            const double lip = 1.0 - smoothstep(0.6 * half_width, 1.1 * half_width, std::abs(x - mx));
             w = to_lower[v] < to_upper[v] ? std::max(w, lip) : std::min(w, 1.0 - lip);
         }
-        // The neck below the chin and the head behind the jaw joint stay.
-        w *= smoothstep(chin_y - 0.45 * es0, chin_y - 0.08 * es0, y);
-        w *= smoothstep(P[2] - 0.2 * es0, P[2] + 0.15 * es0, z);
+        // The neck below the chin and the head behind the jaw joint stay; the
+        // fades are long so a wide-open jaw stretches the skin instead of
+        // folding it.
+        w *= smoothstep(chin_y - 0.8 * es0, chin_y - 0.08 * es0, y);
+        w *= smoothstep(P[2] - 0.1 * es0, P[2] + 0.6 * es0, z);
         jaw_weight_[v] = static_cast<float>(w);
     }
     for (int v = 0; v < n; ++v)

@@ -29,13 +29,10 @@
 #include <vector>
 
 #include "emoface/expression/face.h"
+#include "emoface/expression/fap_values.h"
 #include "emoface/fap/fap_table.h"
 
 namespace emoface::expression {
-
-// One value per FAP, index FAP number - 1 (as fap::FapFrame::values); FAPs 1
-// and 2 (viseme, expression) are ignored by the rig.
-using FapValues = std::array<double, fap::kFapCount>;
 
 struct RigOptions {
     // Multiplies every influence radius (1 = the built-in radii, which scale
