@@ -25,6 +25,7 @@
 #include "emoface/common/error.h"
 #include "emoface/expression/default_face.h"
 #include "emoface/fap/fap_io.h"
+#include "emoface/render/face_assets.h"
 #include "emoface/render/face_scene.h"
 #include "emoface/render/platform.h"
 
@@ -90,29 +91,6 @@ double psnr(const render::ImageRGBA8& a, const render::ImageRGBA8& b) {
     return mse == 0.0 ? INFINITY : 10.0 * std::log10(255.0 * 255.0 / mse);
 }
 
-// The key weights of a frame: FAP 2's two (emotion, intensity / 63) pairs,
-// neutral taking the rest. Codes 1..6 are joy .. surprise, the order of
-// expression::WrinkleKey after Neutral.
-std::vector<float> key_weights(const fap::FapFrame& frame) {
-    std::vector<float> w(expression::kWrinkleKeyCount, 0.0f);
-    if (frame.has(2)) {
-        const auto& e = frame.expression;
-        if (e.select1 >= 1 && e.select1 <= 6) w[std::size_t(e.select1)] += float(e.intensity1) / 63.0f;
-        if (e.select2 >= 1 && e.select2 <= 6) w[std::size_t(e.select2)] += float(e.intensity2) / 63.0f;
-    }
-    float sum = 0.0f;
-    for (std::size_t k = 1; k < w.size(); ++k) sum += w[k];
-    if (sum > 1.0f)
-        for (std::size_t k = 1; k < w.size(); ++k) w[k] /= sum;
-    w[0] = std::max(0.0f, 1.0f - std::min(sum, 1.0f));
-    return w;
-}
-
-// The face at each key expression's full intensity, where its key map is
-// made. Until the emotion profiles exist every key is made at the neutral
-// layout (the morph's cost does not depend on where the lines are).
-expression::FapValues key_pose(expression::WrinkleKey) { return expression::FapValues{}; }
-
 void fence() {
     GLsync sync = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
     glClientWaitSync(sync, GL_SYNC_FLUSH_COMMANDS_BIT, GLuint64(10) * 1000000000ull);
@@ -154,25 +132,14 @@ int main(int argc, char** argv) {
         if (fap_path.empty()) fap_path = data_dir + "/fap/demo_tour.fap";
         const fap::FapStream stream = fap::resolve_untransmitted(fap::read_fap_file(fap_path));
 
-        // Setup (not per frame): face, rig, keys.
+        // Setup (not per frame): face, rig, profiles, lines, keys.
         auto t = Clock::now();
-        expression::DefaultFaceOptions face_options;
-        face_options.resolution_scale = face_scale;
-        const expression::Face face = expression::make_default_face(data_dir + "/face", face_options);
-        const expression::FaceRig rig(face);
-        const double face_ms = ms(Clock::now() - t);
-        t = Clock::now();
-        const auto spec = expression::load_wrinkle_spec(data_dir + "/expression/wrinkles.json");
-        std::bitset<expression::kFeatureCount> present;
-        for (int i = 0; i < expression::kFeatureCount; ++i) present[i] = face.feature_points[i].present;
-        auto lines = expression::lines_for_face(
-            expression::load_feature_lines(data_dir + "/expression/feature_lines.json"), present);
-        std::vector<render::WrinkleKey> keys;
-        for (int k = 0; k < expression::kWrinkleKeyCount; ++k)
-            keys.push_back(render::make_wrinkle_key(face, rig, spec, expression::WrinkleKey(k),
-                                                    key_pose(expression::WrinkleKey(k)),
-                                                    map_size));
-        const double keys_ms = ms(Clock::now() - t);
+        render::FaceAssetsOptions ao;
+        ao.face.resolution_scale = face_scale;
+        ao.wrinkle_map_size = map_size;
+        const auto assets = render::load_default_face_assets(data_dir, ao);
+        const double assets_ms = ms(Clock::now() - t);
+        const expression::Face& face = assets->face;
 
         render::PlatformOptions po;
         po.width = width;
@@ -184,7 +151,7 @@ int main(int argc, char** argv) {
         so.backend = backend;
         so.frames = frames_name == "shader" ? render::WrinkleFrames::Shader : render::WrinkleFrames::Mesh;
         t = Clock::now();
-        render::FaceScene scene(platform, face, rig, keys, lines, so);
+        render::FaceScene scene(platform, face, *assets->rig, assets->keys, assets->lines, so);
         const double scene_ms = ms(Clock::now() - t);
         const morph::SetupTimes setup = scene.morpher().setup_times();
 
@@ -192,13 +159,13 @@ int main(int argc, char** argv) {
         std::printf("  morph: %s backend, %s; %d keys %dx%d, %zu lines; interop %s\n",
                     morph::to_string(scene.morpher().backend()),
                     morph::cuda_device_description().c_str(), scene.key_count(), map_size,
-                    map_size, lines.size(), scene.uses_interop() ? "yes" : "no");
+                    map_size, assets->lines.size(), scene.uses_interop() ? "yes" : "no");
         std::printf("  wrinkle UVs and tangent frames: %s\n",
                     frames_name == "shader" ? "vertex shader (closed form)" : "CPU (TangentFrames), uploaded");
         std::printf("  face: %zu vertices, %zu triangles; frame %dx%d, %d samples; FAP %s, %zu frames at %g fps\n",
                     face.mesh.n_vertices(), face.mesh.n_faces(), width, height, platform.samples(),
                     fap_path.c_str(), stream.frames.size(), stream.fps);
-        std::printf("  setup: face+rig %.0f ms, keys %.0f ms, scene %.0f ms\n", face_ms, keys_ms, scene_ms);
+        std::printf("  setup: face, rig, profiles and keys %.0f ms, scene %.0f ms\n", assets_ms, scene_ms);
 
         render::DrawOptions draw;
         draw.camera = scene.frontal_camera(float(width) / float(height));
@@ -207,16 +174,16 @@ int main(int argc, char** argv) {
         auto frame_at = [&](long i) {
             return stream.sample(double(i % std::max<long>(1, long(stream.frames.size()))) / stream.fps);
         };
-        auto faps_of = [](const fap::FapFrame& f) {
-            expression::FapValues v{};
-            std::copy(f.values.begin(), f.values.end(), v.begin());
-            return v;
+        // A frame's state: its FAPs (mix profiles synthesised when it has
+        // only FAP 2, viseme mouths added) and its emotion mix.
+        auto state_of = [&](const fap::FapFrame& f) {
+            return expression::face_state(f, assets->emotions, &assets->visemes);
         };
 
         // The check frame: saved (reference) or compared.
         if (!save.empty() || !compare.empty()) {
-            const fap::FapFrame f = frame_at(check_frame);
-            scene.update(faps_of(f), key_weights(f));
+            const expression::FaceState st = state_of(frame_at(check_frame));
+            scene.update(st.faps, render::key_weights(st.mix));
             platform.begin_frame();
             scene.draw(draw);
             platform.end_frame();
@@ -245,8 +212,8 @@ int main(int argc, char** argv) {
         Series whole;
         for (long i = 0; i < warmup + frames; ++i) {
             const auto t0 = Clock::now();
-            const fap::FapFrame f = frame_at(i);
-            scene.update(faps_of(f), key_weights(f));
+            const expression::FaceState st = state_of(frame_at(i));
+            scene.update(st.faps, render::key_weights(st.mix));
             platform.begin_frame();
             scene.draw(draw);
             platform.end_frame();
@@ -270,9 +237,9 @@ int main(int argc, char** argv) {
 #endif
         for (long i = 0; i < warmup + frames; ++i) {
             auto t0 = Clock::now();
-            const fap::FapFrame f = frame_at(i);
-            const expression::FapValues faps = faps_of(f);
-            const std::vector<float> w = key_weights(f);
+            const expression::FaceState state = state_of(frame_at(i));
+            const expression::FapValues& faps = state.faps;
+            const std::vector<float> w = render::key_weights(state.mix);
             const double sample_ms = ms(Clock::now() - t0);
             scene.update_geometry(faps);
             const render::FrameStageTimes st = scene.last_times();
@@ -334,7 +301,7 @@ int main(int argc, char** argv) {
         row("bump-mapped draw (GL time, + MSAA resolve)", draw_s.median(), draw_s.pct(0.9));
         row("whole frame (sample .. fence)", whole.median(), whole.pct(0.9));
         std::printf("\nper-frame stages in detail (ms)\n");
-        row("sample the FAP stream", sample_s.median(), sample_s.pct(0.9));
+        row("sample the FAP stream + face state (mix)", sample_s.median(), sample_s.pct(0.9));
         row("rig (FAPs to mesh + normals)", rig_s.median(), rig_s.pct(0.9));
         row("layout L* (feature points projected)", layout_s.median(), layout_s.pct(0.9));
         row("wrinkle UVs (vertices projected)", uv_s.median(), uv_s.pct(0.9));

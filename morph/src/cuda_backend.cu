@@ -9,7 +9,8 @@
 //          and the weight once per pixel-line for all sources, hand bilinear
 //          sampling (bit-compatible with the CPU), blend, store.
 //   fast:  warp_kernel over a grid every `fast_cell` pixels writing the
-//          sums of all lines, near_kernel listing each cell's near lines,
+//          sums of all lines, tile_kernel listing each cell's near lines
+//          (and its corner sums without them),
 //          then apply_kernel over the pixels: far sums interpolated, near
 //          lines exact (kernel.h, "fast mode"), texture-unit sampling.
 // Nothing is allocated per frame; buffers for positions, host output and the
@@ -81,6 +82,7 @@ struct KernelArgs {
     float reach;  // iso units, from a cell's centre
     int* near_count;
     unsigned short* near_list;  // [cell][kernel::kMaxNear]
+    float* tile_sums;           // [cell][4 corners][sums_stride(K)], cells with near lines only
 };
 
 __device__ __forceinline__ void store_pixel(const KernelArgs& a, int x, int y, const kernel::Rgba& c) {
@@ -101,9 +103,9 @@ __device__ __forceinline__ void store_pixel(const KernelArgs& a, int x, int y, c
 }
 
 // One thread sums all lines for PX points of one lattice row. On small
-// lattices (line_split > 1, PX = 1) the threadIdx.y threads of a block share
-// one row instead: each sums every line_split-th line and the partial sums
-// meet in shared memory, so a 256² image still fills the GPU.
+// lattices (line_split > 1) the threadIdx.y threads of a block share one row
+// instead: each sums every line_split-th line and the partial sums meet in
+// shared memory, so a 256² image still fills the GPU.
 template <int K, int PX, Law L>
 __global__ void __launch_bounds__(128) warp_kernel(const __grid_constant__ KernelArgs a,
                                                    const __grid_constant__ LineTable table) {
@@ -113,7 +115,7 @@ __global__ void __launch_bounds__(128) warp_kernel(const __grid_constant__ Kerne
     const float4* src = a.lines != nullptr ? a.lines : table.rec;
     const int tid = threadIdx.y * blockDim.x + threadIdx.x;
     const int threads = blockDim.x * blockDim.y;
-    const bool split = PX == 1 && a.line_split > 1;
+    const bool split = a.line_split > 1;
     const int i0 = (blockIdx.x * blockDim.x + threadIdx.x) * PX;
     const int j = split ? blockIdx.y : blockIdx.y * blockDim.y + threadIdx.y;
     const int first_line = split ? threadIdx.y : 0;
@@ -136,26 +138,30 @@ __global__ void __launch_bounds__(128) warp_kernel(const __grid_constant__ Kerne
             kernel::accumulate_line<K, PX, L>(reinterpret_cast<const float*>(r4), x0, y, step, a.b, acc);
         }
     }
-    if constexpr (PX == 1) {
-        if (split) {
-            float* partial = reinterpret_cast<float*>(s_lines + a.chunk_lines * kRec4);
-            __syncthreads();
-            float* mine = partial + (threadIdx.y * blockDim.x + threadIdx.x) * S;
-            mine[0] = acc.w[0];
+    if (split) {
+        float* partial = reinterpret_cast<float*>(s_lines + a.chunk_lines * kRec4);
+        __syncthreads();
+        float* mine = partial + (threadIdx.y * blockDim.x + threadIdx.x) * (S * PX);
+#pragma unroll
+        for (int p = 0; p < PX; ++p) {
+            mine[p * S] = acc.w[p];
 #pragma unroll
             for (int k = 0; k < K; ++k) {
-                mine[1 + 2 * k] = acc.dx[k][0];
-                mine[2 + 2 * k] = acc.dy[k][0];
+                mine[p * S + 1 + 2 * k] = acc.dx[k][p];
+                mine[p * S + 2 + 2 * k] = acc.dy[k][p];
             }
-            __syncthreads();
-            if (threadIdx.y != 0) return;
-            for (int g = 1; g < static_cast<int>(blockDim.y); ++g) {
-                const float* other = partial + (g * blockDim.x + threadIdx.x) * S;
-                acc.w[0] += other[0];
+        }
+        __syncthreads();
+        if (threadIdx.y != 0) return;
+        for (int g = 1; g < static_cast<int>(blockDim.y); ++g) {
+            const float* other = partial + (g * blockDim.x + threadIdx.x) * (S * PX);
+#pragma unroll
+            for (int p = 0; p < PX; ++p) {
+                acc.w[p] += other[p * S];
 #pragma unroll
                 for (int k = 0; k < K; ++k) {
-                    acc.dx[k][0] += other[1 + 2 * k];
-                    acc.dy[k][0] += other[2 + 2 * k];
+                    acc.dx[k][p] += other[p * S + 1 + 2 * k];
+                    acc.dy[k][p] += other[p * S + 2 + 2 * k];
                 }
             }
         }
@@ -193,9 +199,13 @@ __global__ void __launch_bounds__(128) warp_kernel(const __grid_constant__ Kerne
     }
 }
 
-// Fast mode, pass 2: one thread per cell lists the lines near it.
-__global__ void __launch_bounds__(128) near_kernel(const __grid_constant__ KernelArgs a,
+// Fast mode, pass 2: one thread per cell lists the lines near it and, if
+// there are any (and not too many), writes the cell's four corner sums
+// without them, so pass 3 never recomputes them per pixel.
+template <int K, Law L>
+__global__ void __launch_bounds__(128) tile_kernel(const __grid_constant__ KernelArgs a,
                                                    const __grid_constant__ LineTable table) {
+    constexpr int S4 = sums_stride(K);
     const int t = blockIdx.x * blockDim.x + threadIdx.x;
     if (t >= a.tiles_w * a.tiles_h) return;
     const float* records = reinterpret_cast<const float*>(a.lines != nullptr ? a.lines : table.rec);
@@ -203,8 +213,20 @@ __global__ void __launch_bounds__(128) near_kernel(const __grid_constant__ Kerne
     const float half = 0.5f * static_cast<float>(a.cell);
     const float cx = (static_cast<float>(tx * a.cell) + 0.5f + half) * a.inv_extent;
     const float cy = (static_cast<float>(ty * a.cell) + 0.5f + half) * a.inv_extent;
-    a.near_count[t] = kernel::near_lines(records, a.record_floats, a.n_lines, cx, cy, a.reach,
-                                         a.near_list + static_cast<std::size_t>(t) * kernel::kMaxNear);
+    unsigned short* list = a.near_list + static_cast<std::size_t>(t) * kernel::kMaxNear;
+    const int count = kernel::near_lines(records, a.record_floats, a.n_lines, cx, cy, a.reach, list);
+    a.near_count[t] = count;
+    if (count == 0 || count > kernel::kMaxNear) return;
+    for (int c = 0; c < 4; ++c) {
+        const int gx = tx + (c & 1), gy = ty + (c >> 1);
+        float sums[kernel::sum_floats(K)];
+        kernel::far_sums<K, L>(a.grid + (static_cast<std::size_t>(gy) * a.grid_w + gx) * S4, records, a.record_floats,
+                               list, count, (static_cast<float>(gx * a.cell) + 0.5f) * a.inv_extent,
+                               (static_cast<float>(gy * a.cell) + 0.5f) * a.inv_extent, a.b, sums);
+        float* out = a.tile_sums + (static_cast<std::size_t>(t) * 4 + c) * S4;
+#pragma unroll
+        for (int q = 0; q < kernel::sum_floats(K); ++q) out[q] = sums[q];
+    }
 }
 
 // Fast mode, pass 3: four pixels of one row a thread, all in one cell
@@ -214,7 +236,7 @@ __global__ void __launch_bounds__(128) near_kernel(const __grid_constant__ Kerne
 // near lines are added exactly (kernel.h, "fast mode") and the keys sampled
 // through the texture unit.
 template <int K, Law L>
-__global__ void __launch_bounds__(256) apply_kernel(const __grid_constant__ KernelArgs a,
+__global__ void __launch_bounds__(256, 3) apply_kernel(const __grid_constant__ KernelArgs a,
                                                     const __grid_constant__ LineTable table) {
     constexpr int S4 = sums_stride(K) / 4;
     const int x0 = (blockIdx.x * blockDim.x + threadIdx.x) * 4;
@@ -231,51 +253,38 @@ __global__ void __launch_bounds__(256) apply_kernel(const __grid_constant__ Kern
     const bool crowded = count > kernel::kMaxNear;  // every line, exactly
     const float inv_cell = 1.0f / static_cast<float>(a.cell);
 
-    // The two grid columns of the cell, interpolated to this row.
+    // The cell's corner sums (from the grid, or from pass 2 where the cell
+    // has near lines), its two columns interpolated to this row.
     float4 left[S4], right[S4];
     if (!crowded) {
         const float fy = static_cast<float>(y - ty * a.cell) * inv_cell;
-        const float4* g00 = reinterpret_cast<const float4*>(a.grid) + (static_cast<std::size_t>(ty) * a.grid_w + tx) * S4;
-        const float4* g01 = g00 + static_cast<std::size_t>(a.grid_w) * S4;
+        const float4 *c00, *c10, *c01, *c11;
+        if (count == 0) {
+            c00 = reinterpret_cast<const float4*>(a.grid) + (static_cast<std::size_t>(ty) * a.grid_w + tx) * S4;
+            c10 = c00 + S4;
+            c01 = c00 + static_cast<std::size_t>(a.grid_w) * S4;
+            c11 = c01 + S4;
+        } else {
+            c00 = reinterpret_cast<const float4*>(a.tile_sums) + static_cast<std::size_t>(tile) * 4 * S4;
+            c10 = c00 + S4;
+            c01 = c00 + 2 * S4;
+            c11 = c00 + 3 * S4;
+        }
 #pragma unroll
         for (int q = 0; q < S4; ++q) {
-            const float4 t0 = __ldg(g00 + q), b0 = __ldg(g01 + q), t1 = __ldg(g00 + S4 + q), b1 = __ldg(g01 + S4 + q);
+            const float4 t0 = __ldg(c00 + q), b0 = __ldg(c01 + q), t1 = __ldg(c10 + q), b1 = __ldg(c11 + q);
             left[q] = make_float4(t0.x + fy * (b0.x - t0.x), t0.y + fy * (b0.y - t0.y), t0.z + fy * (b0.z - t0.z),
                                   t0.w + fy * (b0.w - t0.w));
             right[q] = make_float4(t1.x + fy * (b1.x - t1.x), t1.y + fy * (b1.y - t1.y), t1.z + fy * (b1.z - t1.z),
                                    t1.w + fy * (b1.w - t1.w));
         }
-        if (count > 0) {  // the grid holds every line: take the near lines' terms out at the corners
-            const float y_top = (static_cast<float>(ty * a.cell) + 0.5f) * inv;
-            const float y_bottom = (static_cast<float>((ty + 1) * a.cell) + 0.5f) * inv;
-#pragma unroll
-            for (int side = 0; side < 2; ++side) {
-                const float cx = (static_cast<float>((tx + side) * a.cell) + 0.5f) * inv;
-                Accum<K, 1> top, bottom;
-                top.clear();
-                bottom.clear();
-                for (int n = 0; n < count; ++n) {
-                    const float* rec = records + list[n] * rf;
-                    kernel::accumulate_line<K, 1, L>(rec, cx, y_top, 0.0f, a.b, top);
-                    kernel::accumulate_line<K, 1, L>(rec, cx, y_bottom, 0.0f, a.b, bottom);
-                }
-                float near[4 * S4];
-                near[0] = top.w[0] + fy * (bottom.w[0] - top.w[0]);
-#pragma unroll
-                for (int k = 0; k < K; ++k) {
-                    near[1 + 2 * k] = top.dx[k][0] + fy * (bottom.dx[k][0] - top.dx[k][0]);
-                    near[2 + 2 * k] = top.dy[k][0] + fy * (bottom.dy[k][0] - top.dy[k][0]);
-                }
-                float* col = reinterpret_cast<float*>(side == 0 ? left : right);
-#pragma unroll
-                for (int q = 0; q < kernel::sum_floats(K); ++q) col[q] -= near[q];
-            }
-        }
     }
 
     const float unit = a.is_float ? 1.0f : 255.0f;
+    // RGBA8 into a plain buffer goes out as one 16-byte store per thread;
+    // anything else is stored pixel by pixel.
+    const bool vector_store = a.out_vector && a.out_kind == OutKind::Pixels && !a.is_float && x0 + 3 < a.width;
     unsigned int packed[4];
-    float4 colours[4];
 #pragma unroll
     for (int p = 0; p < 4; ++p) {
         const int x = x0 + p;
@@ -316,19 +325,15 @@ __global__ void __launch_bounds__(256) apply_kernel(const __grid_constant__ Kern
             kernel::add_weighted(sum, {t.x, t.y, t.z, t.w}, a.weight[k] * unit);
         }
         if (a.normal_map) sum = kernel::renormalise(sum, unit);
-        colours[p] = make_float4(sum.r, sum.g, sum.b, sum.a);
-        packed[p] = kernel::pack_rgba8(sum);
+        if (vector_store)
+            packed[p] = kernel::pack_rgba8(sum);
+        else if (x < a.width)
+            store_pixel(a, x, y, sum);
     }
-    if (a.out_kind == OutKind::Displacement) return;
-    if (a.out_vector && a.out_kind == OutKind::Pixels && !a.is_float && x0 + 3 < a.width) {
+    if (vector_store) {
         unsigned char* row = a.out + static_cast<std::size_t>(y) * a.out_pitch;
         reinterpret_cast<uint4*>(row)[x0 / 4] = make_uint4(packed[0], packed[1], packed[2], packed[3]);
-        return;
     }
-#pragma unroll
-    for (int p = 0; p < 4; ++p)
-        if (x0 + p < a.width)
-            store_pixel(a, x0 + p, y, {colours[p].x, colours[p].y, colours[p].z, colours[p].w});
 }
 
 // ---- run-time choices -> templates -----------------------------------------
@@ -346,6 +351,11 @@ void launch_warp_k(int px, Law law, dim3 grid, dim3 block, std::size_t smem, cud
         if (px == 8) {
             sq ? launch_warp<K, 8, Law::InverseSquare>(grid, block, smem, s, a, t)
                : launch_warp<K, 8, Law::Power>(grid, block, smem, s, a, t);
+            return;
+        }
+        if (px == 2) {
+            sq ? launch_warp<K, 2, Law::InverseSquare>(grid, block, smem, s, a, t)
+               : launch_warp<K, 2, Law::Power>(grid, block, smem, s, a, t);
             return;
         }
     }
@@ -368,6 +378,28 @@ void launch_warp_any(int k, int px, Law law, dim3 grid, dim3 block, std::size_t 
         case 6: launch_warp_k<6>(px, law, grid, block, smem, s, a, t); break;
         case 7: launch_warp_k<7>(px, law, grid, block, smem, s, a, t); break;
         default: launch_warp_k<8>(px, law, grid, block, smem, s, a, t); break;
+    }
+}
+
+template <int K>
+void launch_tile_k(Law law, dim3 grid, dim3 block, cudaStream_t s, const KernelArgs& a, const LineTable& t) {
+    if (law == Law::InverseSquare)
+        tile_kernel<K, Law::InverseSquare><<<grid, block, 0, s>>>(a, t);
+    else
+        tile_kernel<K, Law::Power><<<grid, block, 0, s>>>(a, t);
+}
+
+void launch_tile_any(int k, Law law, dim3 grid, dim3 block, cudaStream_t s, const KernelArgs& a,
+                     const LineTable& t) {
+    switch (k) {
+        case 1: launch_tile_k<1>(law, grid, block, s, a, t); break;
+        case 2: launch_tile_k<2>(law, grid, block, s, a, t); break;
+        case 3: launch_tile_k<3>(law, grid, block, s, a, t); break;
+        case 4: launch_tile_k<4>(law, grid, block, s, a, t); break;
+        case 5: launch_tile_k<5>(law, grid, block, s, a, t); break;
+        case 6: launch_tile_k<6>(law, grid, block, s, a, t); break;
+        case 7: launch_tile_k<7>(law, grid, block, s, a, t); break;
+        default: launch_tile_k<8>(law, grid, block, s, a, t); break;
     }
 }
 
@@ -502,8 +534,10 @@ public:
                    static_cast<std::size_t>(a.grid_w) * grid_h * sums_stride(plan.sources) * sizeof(float));
             ensure(near_count_, near_count_bytes_, tiles * sizeof(int));
             ensure(near_list_, near_list_bytes_, tiles * kernel::kMaxNear * sizeof(unsigned short));
+            ensure(tile_sums_, tile_sums_bytes_, tiles * 4 * sums_stride(plan.sources) * sizeof(float));
             a.near_count = near_count_;
             a.near_list = near_list_;
+            a.tile_sums = tile_sums_;
             KernelArgs g = a;
             g.points_w = a.grid_w;
             g.points_h = grid_h;
@@ -511,9 +545,10 @@ public:
             g.out_kind = OutKind::Sums;
             g.sums = grid_;
             launch_points(plan, g, smem, warp_block);
-            near_kernel<<<static_cast<unsigned>((tiles + 127) / 128), 128, 0, stream_>>>(a, table_);
-            EMOFACE_CUDA_CHECK(cudaGetLastError());
             a.grid = grid_;
+            launch_tile_any(plan.sources, plan.law, dim3(static_cast<unsigned>((tiles + 127) / 128)), dim3(128),
+                            stream_, a, table_);
+            EMOFACE_CUDA_CHECK(cudaGetLastError());
             const dim3 block(8, 32);  // a warp: 8 threads x 4 pixels wide, 4 rows
             const dim3 blocks((width_ + 4 * 8 - 1) / (4 * 8), (height_ + 31) / 32);
             launch_apply_any(plan.sources, plan.law, blocks, block, stream_, a, table_);
@@ -555,15 +590,19 @@ private:
         // point a thread and split the lines of a row over block.y threads.
         KernelArgs a = args;
         const long long points = static_cast<long long>(a.points_w) * a.points_h;
-        int px = 1;
-        if (points >= (1 << 18)) px = 4;
-        if (points >= (1 << 21) && plan.sources <= 3) px = 8;
-        if (px_override_ > 0) px = px_override_;
-        a.line_split = px == 1 && split_lines_ ? static_cast<int>(block.y) : 1;
+        const bool few_sources = plan.sources <= 3;
+        bool split = split_lines_ && points < (1 << 20);
+        int px = split ? (few_sources ? 2 : 1) : (points >= (1 << 21) && few_sources ? 8 : 4);
+        if (px_override_ > 0) {
+            px = px_override_;
+            if (px == 2 && !few_sources) px = 1;
+            split = split && px <= 2;
+        }
+        a.line_split = split ? static_cast<int>(block.y) : 1;
         dim3 blocks((a.points_w + px * block.x - 1) / (px * block.x), (a.points_h + block.y - 1) / block.y);
-        if (a.line_split > 1) {
+        if (split) {
             blocks.y = a.points_h;
-            smem += static_cast<std::size_t>(block.x) * block.y * kernel::sum_floats(plan.sources) * sizeof(float);
+            smem += static_cast<std::size_t>(block.x) * block.y * px * kernel::sum_floats(plan.sources) * sizeof(float);
         }
         launch_warp_any(plan.sources, px, plan.law, blocks, block, smem, stream_, a, table_);
         EMOFACE_CUDA_CHECK(cudaGetLastError());
@@ -583,7 +622,7 @@ private:
         if (const char* v = std::getenv("EMOFACE_MORPH_SPLIT")) split_lines_ = std::atoi(v) != 0;
         if (const char* px = std::getenv("EMOFACE_MORPH_PX")) {
             const int v = std::atoi(px);
-            if (v == 1 || v == 4 || (v == 8 && keys.size() <= 3)) px_override_ = v;
+            if (v == 1 || v == 2 || v == 4 || (v == 8 && keys.size() <= 3)) px_override_ = v;
         }
         EMOFACE_CUDA_CHECK(cudaGetDevice(&device_));
         EMOFACE_CUDA_CHECK(cudaFree(nullptr));  // context creation is not allocation
@@ -644,6 +683,7 @@ private:
         device_free(grid_);
         device_free(near_count_);
         device_free(near_list_);
+        device_free(tile_sums_);
         device_free(out_);
         device_free(disp_);
         if (staging_ != nullptr) cudaFreeHost(staging_);
@@ -673,6 +713,8 @@ private:
     std::size_t near_count_bytes_ = 0;
     unsigned short* near_list_ = nullptr;
     std::size_t near_list_bytes_ = 0;
+    float* tile_sums_ = nullptr;
+    std::size_t tile_sums_bytes_ = 0;
     unsigned char* out_ = nullptr;
     std::size_t out_bytes_ = 0;
     float2* disp_ = nullptr;
@@ -712,7 +754,7 @@ const DeviceStatus& device_status() {
                         ", " + std::to_string(prop.multiProcessorCount) + " SMs)";
         // A device this binary has no code for (see CMAKE_CUDA_ARCHITECTURES).
         cudaFuncAttributes attr{};
-        if ((e = cudaFuncGetAttributes(&attr, near_kernel)) != cudaSuccess) {
+        if ((e = cudaFuncGetAttributes(&attr, tile_kernel<1, Law::InverseSquare>)) != cudaSuccess) {
             s.why = s.description + " has no matching kernel image in this build (" + cudaGetErrorString(e) +
                     "); add its architecture to CMAKE_CUDA_ARCHITECTURES";
             cudaGetLastError();

@@ -173,20 +173,30 @@ EMOFACE_HD EMOFACE_MORPH_INLINE void accumulate_line(const float* rec, float x0,
     const float s_step = step * ex;
     const float v_step = step * nx;
     const float* src = rec + kGeomFloats;
+    // In phases over the run of points, so the two special-function steps
+    // (square root, reciprocal) of different points overlap on the GPU; the
+    // CPU vectorises each phase.
+    float s[PX], v[PX], w[PX];
     EMOFACE_PIXEL_LOOP
     for (int j = 0; j < PX; ++j) {
         // (j == 0 spelled out: the GPU's unrolled first point then costs nothing)
-        const float s = j == 0 ? s0 : s0 + static_cast<float>(j) * s_step;
-        const float v = j == 0 ? v0 : v0 + static_cast<float>(j) * v_step;
-        const float beyond = max0(absf(s) - half_len);
-        const float dist = fast_sqrt(v * v + beyond * beyond);
-        const float w = line_weight<L>(dist * wk + wa, b);
-        acc.w[j] += w;
+        s[j] = j == 0 ? s0 : s0 + static_cast<float>(j) * s_step;
+        v[j] = j == 0 ? v0 : v0 + static_cast<float>(j) * v_step;
+        const float beyond = max0(absf(s[j]) - half_len);
+        w[j] = v[j] * v[j] + beyond * beyond;
+    }
+    EMOFACE_PIXEL_LOOP
+    for (int j = 0; j < PX; ++j) w[j] = fast_sqrt(w[j]) * wk + wa;
+    EMOFACE_PIXEL_LOOP
+    for (int j = 0; j < PX; ++j) w[j] = line_weight<L>(w[j], b);
+    EMOFACE_PIXEL_LOOP
+    for (int j = 0; j < PX; ++j) {
+        acc.w[j] += w[j];
         EMOFACE_UNROLL
         for (int k = 0; k < K; ++k) {
             const float* c = src + kSourceFloats * k;
-            acc.dx[k][j] += w * (c[0] + s * c[2] + v * c[4]);
-            acc.dy[k][j] += w * (c[1] + s * c[3] + v * c[5]);
+            acc.dx[k][j] += w[j] * (c[0] + s[j] * c[2] + v[j] * c[4]);
+            acc.dy[k][j] += w[j] * (c[1] + s[j] * c[3] + v[j] * c[5]);
         }
     }
 }
