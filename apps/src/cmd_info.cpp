@@ -68,6 +68,8 @@ Summary summarize(const FapStream& s) {
     return out;
 }
 
+const char* frames_word(std::size_t n) { return n == 1 ? "frame" : "frames"; }
+
 std::string code_label(std::string_view name, int code) {
     return name.empty() ? fmt::format("code {}", code) : std::string(name);
 }
@@ -96,7 +98,8 @@ void print_text(const std::string& path, const FapStream& s) {
     } else {
         std::vector<std::string> codes;
         for (int c : sum.viseme_codes) codes.push_back(fmt::format("{} ({})", c, code_label(viseme_name(c), c)));
-        fmt::print("  FAP 1     {} frames, visemes {}\n", sum.viseme_frames, fmt::join(codes, ", "));
+        fmt::print("  FAP 1     {} {}, visemes {}\n", sum.viseme_frames, frames_word(sum.viseme_frames),
+                   fmt::join(codes, ", "));
     }
     if (sum.expression_frames == 0) {
         fmt::print("  FAP 2     not used\n");
@@ -104,7 +107,7 @@ void print_text(const std::string& path, const FapStream& s) {
         std::vector<std::string> peaks;
         for (auto [code, intensity] : sum.expression_peak)
             peaks.push_back(fmt::format("{} up to {}", code_label(expression_name(code), code), intensity));
-        fmt::print("  FAP 2     {} frames, {}\n", sum.expression_frames,
+        fmt::print("  FAP 2     {} {}, {}\n", sum.expression_frames, frames_word(sum.expression_frames),
                    peaks.empty() ? std::string("neutral only") : fmt::format("{}", fmt::join(peaks, ", ")));
     }
     if (s.warnings.empty()) {
