@@ -2,9 +2,10 @@
 //
 // Setup (once): key maps in pitched device memory with a texture object over
 // each, one stream, and, when the line table is too large to pass as a kernel
-// parameter, a device table with a pinned staging buffer. A frame passes the
-// line table as a kernel parameter (up to 8 KB: N = 84 lines with 2 sources
-// fit) or copies it once to the device table, then launches:
+// parameter, a device table. A frame passes the line table as a kernel
+// parameter (up to 8 KB: N = 84 lines with 2 sources fit) or uploads it in
+// by-value slices to the device table, then launches (no host
+// synchronisation, so frames can be captured into a CUDA graph):
 //   exact: warp_kernel over the pixels: lines staged in shared memory, u, v
 //          and the weight once per pixel-line for all sources, hand bilinear
 //          sampling (bit-compatible with the CPU), blend, store.
@@ -85,6 +86,14 @@ struct KernelArgs {
     float* tile_sums;           // [cell][4 corners][sums_stride(K)], cells with near lines only
 };
 
+// Copies one 8 KB slice of a line table that is too large to pass by value
+// into the device table. The slice travels as a kernel parameter, so a frame
+// needs no pinned staging buffer, no host synchronisation, and can be
+// captured into a CUDA graph.
+__global__ void __launch_bounds__(256) upload_kernel(const __grid_constant__ LineTable slice, float4* dst, int count) {
+    for (int i = threadIdx.x; i < count; i += blockDim.x) dst[i] = slice.rec[i];
+}
+
 __device__ __forceinline__ void store_pixel(const KernelArgs& a, int x, int y, const kernel::Rgba& c) {
     if (a.out_kind == OutKind::Surface) {
         if (a.is_float)
@@ -107,7 +116,7 @@ __device__ __forceinline__ void store_pixel(const KernelArgs& a, int x, int y, c
 // instead: each sums every line_split-th line and the partial sums meet in
 // shared memory, so a 256² image still fills the GPU.
 template <int K, int PX, Law L>
-__global__ void __launch_bounds__(128) warp_kernel(const __grid_constant__ KernelArgs a,
+__global__ void __launch_bounds__(256) warp_kernel(const __grid_constant__ KernelArgs a,
                                                    const __grid_constant__ LineTable table) {
     constexpr int kRec4 = kernel::record_floats(K) / 4;
     constexpr int S = kernel::sum_floats(K);
@@ -475,22 +484,22 @@ public:
             a.weight[i] = plan.weight[i];
         }
 
-        // The line table: by value when it fits, else one copy to the device.
+        // The line table: by value when it fits, else uploaded to the device
+        // table in by-value slices (upload_kernel).
         const std::size_t table_floats = static_cast<std::size_t>(plan.lines) * plan.record_floats;
         if (table_floats <= 4 * kParamTableFloat4) {
             std::memcpy(table_.rec, plan.records, table_floats * sizeof(float));
             a.lines = nullptr;
         } else {
-            EMOFACE_CUDA_CHECK(cudaEventSynchronize(staged_));  // the last copy has read the staging buffer
-            std::memcpy(staging_, plan.records, table_floats * sizeof(float));
-            EMOFACE_CUDA_CHECK(cudaMemcpyAsync(lines_, staging_, table_floats * sizeof(float),
-                                               cudaMemcpyHostToDevice, stream_));
-            EMOFACE_CUDA_CHECK(cudaEventRecord(staged_, stream_));
+            const std::size_t table4 = table_floats / 4;
+            for (std::size_t at = 0; at < table4; at += kParamTableFloat4) {
+                const int count = static_cast<int>(std::min<std::size_t>(kParamTableFloat4, table4 - at));
+                std::memcpy(slice_.rec, plan.records + 4 * at, static_cast<std::size_t>(count) * sizeof(float4));
+                upload_kernel<<<1, 256, 0, stream_>>>(slice_, lines_ + at, count);
+                EMOFACE_CUDA_CHECK(cudaGetLastError());
+            }
             a.lines = lines_;
         }
-        const int rec4 = plan.record_floats / 4;
-        a.chunk_lines = std::max(1, std::min(plan.lines, kSharedTableBytes / (rec4 * 16)));
-        const std::size_t smem = static_cast<std::size_t>(a.chunk_lines) * rec4 * 16;
 
         // Where the pixels go.
         const bool positions = target.kind == OutputTarget::Kind::Positions;
@@ -520,7 +529,7 @@ public:
             a.points_w = width_;
             a.points_h = height_;
             a.spacing = 1.0f;
-            launch_points(plan, a, smem, warp_block);
+            launch_points(plan, a, warp_block);
         } else {
             const int cell = plan.fast_cell;
             a.cell = cell;
@@ -544,7 +553,7 @@ public:
             g.spacing = static_cast<float>(cell);
             g.out_kind = OutKind::Sums;
             g.sums = grid_;
-            launch_points(plan, g, smem, warp_block);
+            launch_points(plan, g, warp_block);
             a.grid = grid_;
             launch_tile_any(plan.sources, plan.law, dim3(static_cast<unsigned>((tiles + 127) / 128)), dim3(128),
                             stream_, a, table_);
@@ -579,11 +588,11 @@ public:
     }
 
 private:
-    // Shared memory for staged lines per block: 32 KB leaves room for several
-    // blocks per multiprocessor.
-    static constexpr int kSharedTableBytes = 32 * 1024;
+    // Shared memory per block for staged lines (and split partial sums):
+    // under the 48 KB default, and small enough for several blocks per SM.
+    static constexpr std::size_t kSharedBytes = 40 * 1024;
 
-    void launch_points(const FramePlan& plan, const KernelArgs& args, std::size_t smem, dim3 block) {
+    void launch_points(const FramePlan& plan, const KernelArgs& args, dim3 block) {
         // Several points a thread amortise the line loads (8 where the sums
         // of up to 3 sources leave registers to spare, else 4); on small
         // lattices that would leave the GPU too few threads, so take one
@@ -591,19 +600,26 @@ private:
         KernelArgs a = args;
         const long long points = static_cast<long long>(a.points_w) * a.points_h;
         const bool few_sources = plan.sources <= 3;
-        bool split = split_lines_ && points < (1 << 20);
+        bool split = split_groups_ > 1 && points < (1 << 20);
         int px = split ? (few_sources ? 2 : 1) : (points >= (1 << 21) && few_sources ? 8 : 4);
         if (px_override_ > 0) {
             px = px_override_;
             if (px == 2 && !few_sources) px = 1;
             split = split && px <= 2;
         }
+        if (split) block.y = split_groups_;
         a.line_split = split ? static_cast<int>(block.y) : 1;
         dim3 blocks((a.points_w + px * block.x - 1) / (px * block.x), (a.points_h + block.y - 1) / block.y);
-        if (split) {
-            blocks.y = a.points_h;
-            smem += static_cast<std::size_t>(block.x) * block.y * px * kernel::sum_floats(plan.sources) * sizeof(float);
-        }
+        // Shared memory: staged lines, plus the partial sums when splitting;
+        // within the 48 KB a block gets without opting in.
+        const std::size_t reduce =
+            split ? static_cast<std::size_t>(block.x) * block.y * px * kernel::sum_floats(plan.sources) * sizeof(float)
+                  : 0;
+        const std::size_t record_bytes = static_cast<std::size_t>(plan.record_floats) * sizeof(float);
+        a.chunk_lines = static_cast<int>(std::max<std::size_t>(
+            1, std::min<std::size_t>(plan.lines, (kSharedBytes - reduce) / record_bytes)));
+        const std::size_t smem = a.chunk_lines * record_bytes + reduce;
+        if (split) blocks.y = a.points_h;
         launch_warp_any(plan.sources, px, plan.law, blocks, block, smem, stream_, a, table_);
         EMOFACE_CUDA_CHECK(cudaGetLastError());
     }
@@ -619,7 +635,10 @@ private:
     }
 
     void setup(const std::vector<KeyMap>& keys) {
-        if (const char* v = std::getenv("EMOFACE_MORPH_SPLIT")) split_lines_ = std::atoi(v) != 0;
+        if (const char* v = std::getenv("EMOFACE_MORPH_SPLIT")) {
+            const int g = std::atoi(v);
+            if (g == 0 || g == 2 || g == 4 || g == 8) split_groups_ = g;
+        }
         if (const char* px = std::getenv("EMOFACE_MORPH_PX")) {
             const int v = std::atoi(px);
             if (v == 1 || v == 2 || v == 4 || (v == 8 && keys.size() <= 3)) px_override_ = v;
@@ -628,7 +647,6 @@ private:
         EMOFACE_CUDA_CHECK(cudaFree(nullptr));  // context creation is not allocation
         auto t0 = Clock::now();
         EMOFACE_CUDA_CHECK(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking));
-        EMOFACE_CUDA_CHECK(cudaEventCreateWithFlags(&staged_, cudaEventDisableTiming));
         const std::size_t row = static_cast<std::size_t>(width_) * pixel_bytes_;
         keys_.assign(keys.size(), nullptr);
         textures_.assign(keys.size(), 0);
@@ -640,10 +658,8 @@ private:
         // The device line table, for tables that do not fit the parameter.
         const std::size_t table_floats =
             static_cast<std::size_t>(keys[0].layout.size()) * kernel::record_floats(static_cast<int>(keys.size()));
-        if (table_floats > 4 * kParamTableFloat4) {
+        if (table_floats > 4 * kParamTableFloat4)
             EMOFACE_CUDA_CHECK(cudaMalloc(reinterpret_cast<void**>(&lines_), table_floats * sizeof(float)));
-            EMOFACE_CUDA_CHECK(cudaMallocHost(reinterpret_cast<void**>(&staging_), table_floats * sizeof(float)));
-        }
         for (std::size_t k = 0; k < keys.size(); ++k) {
             cudaResourceDesc res{};
             res.resType = cudaResourceTypePitch2D;
@@ -686,10 +702,6 @@ private:
         device_free(tile_sums_);
         device_free(out_);
         device_free(disp_);
-        if (staging_ != nullptr) cudaFreeHost(staging_);
-        staging_ = nullptr;
-        if (staged_ != nullptr) cudaEventDestroy(staged_);
-        staged_ = nullptr;
         if (stream_ != nullptr) cudaStreamDestroy(stream_);
         stream_ = nullptr;
     }
@@ -698,15 +710,13 @@ private:
     bool is_float_;
     std::size_t pixel_bytes_;
     int px_override_ = 0;       // EMOFACE_MORPH_PX=1|4|8, for the benchmark's sweeps
-    bool split_lines_ = true;   // EMOFACE_MORPH_SPLIT=0 turns the line split off (benchmark)
+    int split_groups_ = 4;      // EMOFACE_MORPH_SPLIT=0|2|4|8: threads sharing a row's lines (benchmark)
     int device_ = 0;
     cudaStream_t stream_ = nullptr;
-    cudaEvent_t staged_ = nullptr;
     std::vector<unsigned char*> keys_;
     std::vector<cudaTextureObject_t> textures_;
     std::size_t key_pitch_ = 0;
     float4* lines_ = nullptr;
-    float* staging_ = nullptr;
     float* grid_ = nullptr;
     std::size_t grid_bytes_ = 0;
     int* near_count_ = nullptr;
@@ -719,7 +729,8 @@ private:
     std::size_t out_bytes_ = 0;
     float2* disp_ = nullptr;
     std::size_t disp_bytes_ = 0;
-    LineTable table_;  // host copy of the by-value table (8 KB, not on the stack)
+    LineTable table_;  // host copies of by-value tables (8 KB each, not on the stack)
+    LineTable slice_;
     SetupTimes times_;
 };
 
