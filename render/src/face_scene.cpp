@@ -273,13 +273,18 @@ void FaceScene::draw(const DrawOptions& options) {
 }
 
 Camera FaceScene::frontal_camera(float aspect, float fovy_degrees) const {
+    // Frame the face (its texture box, where the wrinkles are) with some of
+    // the head around it, not the neck.
     glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
     for (const auto vh : face_.mesh.vertices()) {
         const auto& p = face_.mesh.point(vh);
         lo = glm::min(lo, glm::vec3(p[0], p[1], p[2]));
         hi = glm::max(hi, glm::vec3(p[0], p[1], p[2]));
     }
-    return Camera::frontal(lo, hi, aspect, fovy_degrees, 0.92f);
+    const glm::vec2 margin = 0.12f * (box_.max - box_.min);
+    lo = glm::vec3(glm::max(glm::vec2(lo), box_.min - margin), lo.z);
+    hi = glm::vec3(glm::min(glm::vec2(hi), box_.max + margin), hi.z);
+    return Camera::frontal(lo, hi, aspect, fovy_degrees, 0.95f);
 }
 
 Light FaceScene::portrait_light() const {
