@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <fstream>
 #include <map>
 #include <memory>
@@ -36,6 +37,14 @@ using morph::Backend;
 using morph::Morpher;
 using morph::MorphParams;
 using Clock = std::chrono::steady_clock;
+
+// Processor time of the whole process (all threads), ms: on a loaded
+// machine, wall time overstates what a frame costs; this does not.
+double process_cpu_ms() {
+    timespec ts{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
 
 double median(std::vector<double> v) {
     if (v.empty()) return NAN;
@@ -67,6 +76,7 @@ struct Row {
     double single_ms = NAN;  // CUDA: one frame alone, median
     double graph_ms = NAN;   // CUDA: per frame, a captured batch replayed as a graph (no host work), median
     double host_us = NAN;    // CUDA: host time to validate, build and enqueue one frame, median
+    double cpu_ms = NAN;     // CPU: processor time per frame over all threads, median
     int batch = 1;
     int runs = 0;
     double err_max = NAN, err_p999 = NAN;  // fast: source position error, pixels
@@ -118,14 +128,14 @@ public:
         s << "command: `" << command << "`\n\n";
         s << "device: " << morph::cuda_device_description() << "; host threads: "
           << std::max(1u, std::thread::hardware_concurrency()) << "\n\n";
-        s << "| size | N | K | backend | ms/frame | single frame ms | graph ms/frame | host µs/frame | batch | runs | "
-             "G px-lines/s | x thesis | fast max err px | fast p99.9 err px |\n";
-        s << "|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+        s << "| size | N | K | backend | ms/frame | single frame ms | graph ms/frame | host µs/frame | CPU ms/frame | "
+             "batch | runs | G px-lines/s | x thesis | fast max err px | fast p99.9 err px |\n";
+        s << "|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
         for (const Row& r : rows_) {
             const double thesis = thesis_ms(r);
             s << "| " << r.size << "² | " << r.lines << " | " << r.keys << " | " << r.backend << " | "
               << fmt(r.ms, 4) << " | " << fmt(r.single_ms, 4) << " | " << fmt(r.graph_ms, 4) << " | "
-              << fmt(r.host_us, 1) << " | " << r.batch << " | " << r.runs << " | "
+              << fmt(r.host_us, 1) << " | " << fmt(r.cpu_ms, 2) << " | " << r.batch << " | " << r.runs << " | "
               << fmt(r.gpl(), 1) << " | " << (std::isnan(thesis) || r.backend == "thesis" ? "-" : fmt(thesis / r.ms, 1))
               << " | " << fmt(r.err_max, 3) << " | " << fmt(r.err_p999, 3) << " |\n";
         }
@@ -222,11 +232,14 @@ private:
         params.fast_cell = cell;
         params.fast_reach = reach;
         std::vector<std::uint8_t> out(static_cast<std::size_t>(size) * size * 4);
+        std::vector<double> cpu;
         auto frame = [&](int i) {
             const bench::InputSet& in = inputs[i % 2];
             const int t = (i / 2) % static_cast<int>(in.targets.size());
+            const double c0 = process_cpu_ms();
             const auto t0 = Clock::now();
             m[i % 2]->morph_to_host(in.targets[t], in.weights[t], params, out.data());
+            cpu.push_back(process_cpu_ms() - c0);
             return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
         };
         const double first = frame(0);
@@ -234,8 +247,10 @@ private:
         for (int i = 1; i <= warm; ++i) frame(i);
         const int runs = std::clamp(static_cast<int>(o_.cpu_budget_s * 1000.0 / std::max(first, 1e-3)), 5, o_.runs);
         std::vector<double> t;
+        cpu.clear();
         for (int i = 0; i < runs; ++i) t.push_back(frame(i));
         Row r;
+        r.cpu_ms = median(cpu);
         r.size = size;
         r.lines = lines;
         r.keys = keys;
