@@ -140,9 +140,8 @@ EmotionMix parse_emotion_mix(std::string_view text, bool normalise) {
         else mix[*e] = w;
     }
     const double total = mix.sum() + neutral;
-    if (normalise) {
-        if (total > 0)
-            for (double& w : mix.weights) w /= total;
+    if (total > 1.0 + 1e-9 && normalise) {
+        for (double& w : mix.weights) w /= total;
     } else if (total > 1.0 + 1e-9) {
         bad(fmt::format("weights sum to {:g}, more than 1 (neutral takes 1 - sum); lower them or let the mix be "
                         "normalised",

@@ -45,6 +45,16 @@ FeatureLayout projective_layout(const std::array<glm::vec3, kFeatureCount>& posi
     return layout;
 }
 
+FeatureLayout projective_layout(const fap::FeaturePointPositions& positions,
+                                const std::bitset<kFeatureCount>& present,
+                                const TextureBox& box) {
+    std::array<glm::vec3, kFeatureCount> points{};
+    for (int i = 0; i < kFeatureCount; ++i)
+        points[i] = {static_cast<float>(positions[i][0]), static_cast<float>(positions[i][1]),
+                     static_cast<float>(positions[i][2])};
+    return projective_layout(points, present, box);
+}
+
 FeatureLayout anchored_layout(const std::array<glm::vec2, kFeatureCount>& uvs,
                               const std::bitset<kFeatureCount>& present) {
     FeatureLayout layout;

@@ -44,7 +44,7 @@ bool operator!=(const EmotionMix& a, const EmotionMix& b);
 // for an empty text or part, a part that is none of the forms, an unknown
 // name, a weight that is not a number, negative or above 1, an emotion given
 // twice, and a sum above 1 unless `normalise` (then all weights, neutral's
-// too, are divided by their sum).
+// too, are divided by their sum; a sum of 1 or less is kept as given).
 EmotionMix parse_emotion_mix(std::string_view text, bool normalise = false);
 
 }  // namespace emoface::expression

@@ -15,6 +15,7 @@
 #include <glm/vec3.hpp>
 
 #include "emoface/fap/feature_points.h"
+#include "emoface/fap/fapu.h"
 
 namespace emoface::expression {
 
@@ -46,6 +47,11 @@ struct FeatureLayout {
 
 // `projective` layout: every present feature point projected into the box.
 FeatureLayout projective_layout(const std::array<glm::vec3, kFeatureCount>& positions,
+                                const std::bitset<kFeatureCount>& present,
+                                const TextureBox& box);
+
+// The same from the rig's double-precision feature points.
+FeatureLayout projective_layout(const fap::FeaturePointPositions& positions,
                                 const std::bitset<kFeatureCount>& present,
                                 const TextureBox& box);
 

@@ -1,0 +1,244 @@
+// The default face: proportions, feature points, mesh soundness, parts, base
+// colour, and the parameter file's error messages.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include <unistd.h>
+
+#include "emoface/common/error.h"
+#include "emoface/expression/default_face.h"
+#include "emoface/fap/feature_points.h"
+#include "test_face.h"
+
+namespace emoface::expression {
+namespace {
+
+using testing::fp;
+using testing::test_face;
+
+TEST(DefaultFace, FapuArePositiveAndInHumanProportions) {
+    const fap::Fapu& u = test_face().fapu;
+    const double es0 = u.es * 1024, mw0 = u.mw * 1024, ens0 = u.ens * 1024, mns0 = u.mns * 1024, irisd0 = u.irisd * 1024;
+    // Millimetres. An adult's pupils are 55-72 mm apart, the mouth 45-60 mm
+    // wide, eyes to nose base 40-60 mm, nose base to mouth 12-24 mm, the
+    // open eye 8-12 mm high. (Eyes are set wider than the mouth is wide, so
+    // ES0 > MW0 on a human face.)
+    EXPECT_GT(es0, 55);
+    EXPECT_LT(es0, 72);
+    EXPECT_GT(mw0, 45);
+    EXPECT_LT(mw0, 60);
+    EXPECT_GT(ens0, 40);
+    EXPECT_LT(ens0, 60);
+    EXPECT_GT(mns0, 12);
+    EXPECT_LT(mns0, 24);
+    EXPECT_GT(irisd0, 8);
+    EXPECT_LT(irisd0, 12);
+    EXPECT_GT(es0, mw0);
+    EXPECT_GT(mw0, ens0);
+    EXPECT_GT(ens0, mns0);
+    EXPECT_GT(mns0, irisd0);
+    EXPECT_DOUBLE_EQ(u.au, 1e-5);
+}
+
+TEST(DefaultFace, HasAll84FeaturePointsMirroredLeftToRight) {
+    const Face& f = test_face();
+    EXPECT_TRUE(missing_feature_points(f).empty());
+    // Left (odd) and right (even) pairs mirror each other across x = 0.
+    const std::pair<const char*, const char*> pairs[] = {
+        {"2.4", "2.5"}, {"2.6", "2.7"}, {"3.1", "3.2"}, {"3.5", "3.6"}, {"3.7", "3.12"}, {"3.11", "3.8"},
+        {"4.1", "4.2"}, {"4.5", "4.6"}, {"5.1", "5.2"}, {"8.3", "8.4"}, {"9.1", "9.2"},   {"10.1", "10.2"}};
+    for (auto [l, r] : pairs) {
+        SCOPED_TRACE(std::string(l) + "/" + r);
+        const Vec3d a = f.position(fp(l)), b = f.position(fp(r));
+        EXPECT_GT(a[0], 0.0);
+        EXPECT_NEAR(a[0], -b[0], 0.05);
+        EXPECT_NEAR(a[1], b[1], 0.05);
+        EXPECT_NEAR(a[2], b[2], 0.05);
+    }
+    // Midline points and an ordering check: brows over eyes over nose tip
+    // over mouth over chin; the nose tip is the most forward of them.
+    for (const char* id : {"2.1", "2.2", "2.3", "8.1", "8.2", "9.3", "9.15", "11.4"})
+        EXPECT_NEAR(f.position(fp(id))[0], 0.0, 0.05) << id;
+    EXPECT_GT(f.position(fp("4.3"))[1], f.position(fp("3.1"))[1]);
+    EXPECT_GT(f.position(fp("3.3"))[1], f.position(fp("9.3"))[1]);
+    EXPECT_GT(f.position(fp("9.15"))[1], f.position(fp("8.1"))[1]);
+    EXPECT_GT(f.position(fp("8.2"))[1], f.position(fp("2.10"))[1]);
+    EXPECT_GT(f.position(fp("2.10"))[1], f.position(fp("2.1"))[1]);
+    EXPECT_GT(f.position(fp("9.3"))[2], f.position(fp("8.1"))[2]);
+    // The closed mouth: the inner lip points coincide, on two vertices.
+    EXPECT_LT(testing::distance(f.position(fp("2.2")), f.position(fp("2.3"))), 1e-6);
+    EXPECT_NE(f.feature_points[fp("2.2")].vertex, f.feature_points[fp("2.3")].vertex);
+}
+
+TEST(DefaultFace, FullResolutionHasSeveralThousandVertices) {
+    DefaultFaceOptions options;
+    options.texture_size = 16;
+    const Face f = make_default_face(testing::data_dir() + "/face", options);
+    EXPECT_GT(f.vertex_count(), 20000);
+    EXPECT_GT(static_cast<int>(f.mesh.n_faces()), 2 * 20000 - 2000);
+}
+
+TEST(DefaultFace, SkinIsOrientedOutwardWithoutFolds) {
+    const Face& f = test_face();
+    int folded = 0, skin = 0;
+    for (auto fh : f.mesh.faces()) {
+        bool all_skin = true;
+        OpenMesh::Vec3f vn(0, 0, 0);
+        for (auto vh : f.mesh.fv_range(fh)) {
+            all_skin &= f.parts[vh.idx()] == VertexPart::Skin;
+            vn += f.mesh.normal(vh);
+        }
+        if (!all_skin) continue;
+        ++skin;
+        if ((f.mesh.calc_face_normal(fh) | vn) < 0) ++folded;
+    }
+    EXPECT_GT(skin, 5000);
+    EXPECT_EQ(folded, 0);
+    // Outward: the nose tip's normal faces the viewer, the crown's points up.
+    EXPECT_GT(f.mesh.normal(TriMesh::VertexHandle(f.feature_points[fp("9.3")].vertex))[2], 0.5f);
+    EXPECT_GT(f.mesh.normal(TriMesh::VertexHandle(f.feature_points[fp("11.4")].vertex))[1], 0.9f);
+}
+
+TEST(DefaultFace, EyeballsSitUnderOpenLidsAndPartsAreContiguous) {
+    const Face& f = test_face();
+    ASSERT_EQ(f.eyeballs.size(), 2u);
+    for (int side = 0; side < 2; ++side) {
+        const Eyeball& e = f.eyeballs[side];
+        SCOPED_TRACE(side);
+        EXPECT_EQ(e.centre[0] > 0, side == 0);
+        // The pupil (3.5 / 3.6) is the eyeball's front pole.
+        const Vec3d pupil = f.position(fp(side == 0 ? "3.5" : "3.6"));
+        EXPECT_NEAR(pupil[2] - e.centre[2], e.radius, 1e-4);
+        for (int v = e.vertices.first; v < e.vertices.end(); ++v) {
+            EXPECT_EQ(f.parts[v], side == 0 ? VertexPart::EyeballLeft : VertexPart::EyeballRight);
+            EXPECT_NEAR(testing::distance(testing::to_vec(f.mesh.point(TriMesh::VertexHandle(v))), e.centre), e.radius, 1e-3);
+        }
+        ASSERT_EQ(e.upper_margin.size(), e.lower_margin.size());
+        ASSERT_GE(e.upper_margin.size(), 5u);
+        // Corners shared, the opening in between; margins lie just outside the eyeball.
+        EXPECT_EQ(e.upper_margin.front(), e.lower_margin.front());
+        EXPECT_EQ(e.upper_margin.back(), e.lower_margin.back());
+        const std::size_t mid = e.upper_margin.size() / 2;
+        const auto up = f.mesh.point(TriMesh::VertexHandle(e.upper_margin[mid]));
+        const auto lo = f.mesh.point(TriMesh::VertexHandle(e.lower_margin[mid]));
+        EXPECT_GT(up[1] - lo[1], 8.0);
+        for (int v : e.upper_margin)
+            EXPECT_GE(testing::distance(testing::to_vec(f.mesh.point(TriMesh::VertexHandle(v))), e.centre), e.radius);
+    }
+    // Every part is present and each is one contiguous run of vertices
+    // (render splits the mesh by them).
+    for (VertexPart part : {VertexPart::Skin, VertexPart::EyeballLeft, VertexPart::EyeballRight,
+                            VertexPart::MouthUpper, VertexPart::MouthLower, VertexPart::Tongue}) {
+        int first = -1, last = -1, count = 0;
+        for (int v = 0; v < f.vertex_count(); ++v)
+            if (f.parts[v] == part) {
+                if (first < 0) first = v;
+                last = v;
+                ++count;
+            }
+        EXPECT_GT(count, 0) << part_name(part);
+        if (part != VertexPart::MouthUpper && part != VertexPart::MouthLower)
+            EXPECT_EQ(last - first + 1, count) << part_name(part);
+    }
+    // Tongue and teeth points are on their parts.
+    EXPECT_EQ(f.parts[f.feature_points[fp("6.1")].vertex], VertexPart::Tongue);
+    EXPECT_EQ(f.parts[f.feature_points[fp("9.10")].vertex], VertexPart::MouthUpper);
+    EXPECT_EQ(f.parts[f.feature_points[fp("9.11")].vertex], VertexPart::MouthLower);
+    // 7.1 (top of the spine) and 11.5 have no vertex.
+    EXPECT_EQ(f.feature_points[fp("7.1")].vertex, -1);
+    EXPECT_TRUE(f.has(fp("7.1")));
+}
+
+TEST(DefaultFace, BaseColourPaintsLipsRedderThanSkinAndHairDarker) {
+    DefaultFaceOptions options;
+    options.resolution_scale = 0.5;
+    options.texture_size = 256;
+    const Face f = make_default_face(testing::data_dir() + "/face", options);
+    ASSERT_EQ(f.base_colour.width, 256);
+    ASSERT_EQ(f.base_colour.height, 256);
+    auto texel_at = [&](TriMesh::TexCoord2D t) {
+        const int x = std::min(255, static_cast<int>(t[0] * 256));
+        const int y = std::min(255, static_cast<int>((1 - t[1]) * 256));
+        const std::uint8_t* p = &f.base_colour.rgba[(static_cast<std::size_t>(y) * 256 + x) * 4];
+        EXPECT_EQ(p[3], 255);
+        return std::array<int, 3>{p[0], p[1], p[2]};
+    };
+    auto texel = [&](int vertex) { return texel_at(f.mesh.texcoord2D(TriMesh::VertexHandle(vertex))); };
+    // Inside the lower lip: halfway from where the lips meet (2.3) to its border (8.2).
+    const auto lip = texel_at((f.mesh.texcoord2D(TriMesh::VertexHandle(f.feature_points[fp("2.3")].vertex)) +
+                               f.mesh.texcoord2D(TriMesh::VertexHandle(f.feature_points[fp("8.2")].vertex))) *
+                              0.5f);
+    const auto cheek = texel(f.feature_points[fp("5.1")].vertex);
+    const auto crown = texel(f.feature_points[fp("11.4")].vertex);
+    // Lips: less green relative to red than skin.
+    EXPECT_LT(lip[1] * 1.0 / lip[0], cheek[1] * 1.0 / cheek[0] - 0.05);
+    EXPECT_LT(crown[0] + crown[1] + crown[2], (cheek[0] + cheek[1] + cheek[2]) / 2);
+}
+
+class BadFaceParams : public ::testing::Test {
+protected:
+    void SetUp() override {
+        dir_ = std::filesystem::temp_directory_path() / ("emoface_face_params_" + std::to_string(::getpid()));
+        std::filesystem::create_directories(dir_);
+        std::ifstream in(testing::data_dir() + "/face/face.json");
+        original_ = std::string(std::istreambuf_iterator<char>(in), {});
+    }
+    void TearDown() override { std::filesystem::remove_all(dir_); }
+    std::string write(const std::string& text) {
+        std::ofstream(dir_ / "face.json") << text;
+        return dir_.string();
+    }
+    std::string replaced(const std::string& from, const std::string& to) {
+        std::string s = original_;
+        const auto at = s.find(from);
+        EXPECT_NE(at, std::string::npos) << from;
+        return s.replace(at, from.size(), to);
+    }
+    std::filesystem::path dir_;
+    std::string original_;
+};
+
+TEST_F(BadFaceParams, MessagesNameTheFileAndKey) {
+    const std::string file = (dir_ / "face.json").string();
+    struct Case {
+        std::string text;
+        std::string message;
+    } cases[] = {
+        {replaced("\"radius\": 12.5,", "\"radius\": 12.5, \"radiuss\": 1,"),
+         "expression: " + file + ": unknown key \"eyes.radiuss\""},
+        {replaced("\"iris_radius\": 5.9,", ""), "expression: " + file + ": missing key \"eyes.iris_radius\""},
+        {replaced("\"centre_y\": -66,", "\"centre_y\": \"low\","),
+         "expression: " + file + ": \"mouth.centre_y\" must be a number"},
+        {replaced("\"texture_size\": 2048", "\"texture_size\": 9"),
+         "expression: " + file + ": texture_size must be in [16, 8192]"},
+        {replaced("\"2.10\": [0, -104],", "\"2.10\": [0, -104], \"2.99\": [0, 0],"),
+         "expression: " + file + ": feature_points: \"2.99\" is not an MPEG-4 feature point"},
+        {replaced("\"2.10\": [0, -104],", "\"2.10\": [0, -104], \"3.1\": [0, 0],"),
+         "expression: " + file + ": feature_points: \"3.1\" is placed by the generator; remove it"},
+        {replaced("\"2.10\": [0, -104],", ""), "expression: " + file + ": feature_points: no target for \"2.10\""},
+    };
+    for (const Case& c : cases) {
+        const std::string dir = write(c.text);
+        try {
+            make_default_face(dir, {0.3, 16});
+            ADD_FAILURE() << "no error for: " << c.message;
+        } catch (const InputError& e) {
+            EXPECT_EQ(std::string(e.what()), c.message);
+        }
+    }
+    write("{ not json");
+    EXPECT_THROW(make_default_face(dir_.string()), InputError);
+    EXPECT_THROW(make_default_face((dir_ / "nowhere").string()), InputError);
+}
+
+TEST(DefaultFace, RejectsBadOptions) {
+    EXPECT_THROW(make_default_face(testing::data_dir() + "/face", {0.0, 0}), InputError);
+    EXPECT_THROW(make_default_face(testing::data_dir() + "/face", {1.0, 3}), InputError);
+}
+
+}  // namespace
+}  // namespace emoface::expression

@@ -1,0 +1,199 @@
+// EmotionMix: what parse_emotion_mix accepts and the exact message for each
+// thing it rejects; the profile files.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "emoface/common/error.h"
+#include "emoface/expression/emotion.h"
+#include "emoface/expression/profiles.h"
+
+namespace emoface::expression {
+namespace {
+
+EmotionMix mix(std::initializer_list<std::pair<Emotion, double>> w) {
+    EmotionMix m;
+    for (auto [e, v] : w) m[e] = v;
+    return m;
+}
+
+TEST(EmotionMix, AcceptsBothNotationsAndHappiness) {
+    struct Case {
+        const char* text;
+        EmotionMix expected;
+    } cases[] = {
+        {"anger=0.7,fear=0.3", mix({{Emotion::Anger, 0.7}, {Emotion::Fear, 0.3}})},
+        {"0.7 anger + 0.3 fear", mix({{Emotion::Anger, 0.7}, {Emotion::Fear, 0.3}})},
+        {" Anger = 0.7 , FEAR=0.3 ", mix({{Emotion::Anger, 0.7}, {Emotion::Fear, 0.3}})},
+        {"happiness=0.5", mix({{Emotion::Joy, 0.5}})},
+        {"0.5 joy + 0.5 surprise", mix({{Emotion::Joy, 0.5}, {Emotion::Surprise, 0.5}})},
+        {"sadness", mix({{Emotion::Sadness, 1.0}})},
+        {"disgust=0", mix({})},
+        {"0.25 neutral + 0.75 disgust", mix({{Emotion::Disgust, 0.75}})},
+        {"anger=+0.5", mix({{Emotion::Anger, 0.5}})},
+        {"1 anger", mix({{Emotion::Anger, 1.0}})},
+        {"joy=.2,sadness=.2,anger=.2,fear=.2,disgust=.1,surprise=.1",
+         mix({{Emotion::Joy, .2}, {Emotion::Sadness, .2}, {Emotion::Anger, .2}, {Emotion::Fear, .2},
+              {Emotion::Disgust, .1}, {Emotion::Surprise, .1}})},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.text);
+        const EmotionMix m = parse_emotion_mix(c.text);
+        for (int e = 0; e < kEmotionCount; ++e) EXPECT_NEAR(m.weights[e], c.expected.weights[e], 1e-12);
+    }
+    EXPECT_NEAR(parse_emotion_mix("anger=0.7,fear=0.3").neutral(), 0.0, 1e-12);
+    EXPECT_NEAR(parse_emotion_mix("anger=0.2").neutral(), 0.8, 1e-12);
+}
+
+TEST(EmotionMix, RejectsWithMessagesThatNameThePart) {
+    const std::string expected_names =
+        "expected joy (or happiness), sadness, anger, fear, disgust, surprise or neutral";
+    struct Case {
+        const char* text;
+        std::string message;
+    } cases[] = {
+        {"", "expression: emotion mix \"\": empty; expected e.g. \"anger=0.7,fear=0.3\" or \"0.7 anger + 0.3 fear\""},
+        {"   ", "expression: emotion mix \"   \": empty; expected e.g. \"anger=0.7,fear=0.3\" or \"0.7 anger + 0.3 fear\""},
+        {"anger=0.7,fera=0.3",
+         "expression: emotion mix \"anger=0.7,fera=0.3\": unknown emotion \"fera\" in part 2 (\"fera=0.3\"); " +
+             expected_names},
+        {"0.5 rage", "expression: emotion mix \"0.5 rage\": unknown emotion \"rage\" in part 1 (\"0.5 rage\"); " +
+                         expected_names},
+        {"anger=-0.3", "expression: emotion mix \"anger=-0.3\": part 1 (\"anger=-0.3\"): weight -0.3 is negative; "
+                       "weights are in [0, 1]"},
+        {"joy=1.5", "expression: emotion mix \"joy=1.5\": part 1 (\"joy=1.5\"): weight 1.5 is above 1; weights are "
+                    "in [0, 1]"},
+        {"anger=0.7,fear=0.5", "expression: emotion mix \"anger=0.7,fear=0.5\": weights sum to 1.2, more than 1 "
+                               "(neutral takes 1 - sum); lower them or let the mix be normalised"},
+        {"0.7 anger + 0.6 fear", "expression: emotion mix \"0.7 anger + 0.6 fear\": weights sum to 1.3, more than 1 "
+                                 "(neutral takes 1 - sum); lower them or let the mix be normalised"},
+        {"anger=0.2,anger=0.3", "expression: emotion mix \"anger=0.2,anger=0.3\": \"anger\" is given twice (parts 1 "
+                                "and 2)"},
+        {"joy=0.2 + happiness=0.1", "expression: emotion mix \"joy=0.2 + happiness=0.1\": \"joy\" is given twice "
+                                    "(parts 1 and 2)"},
+        {"anger=0.5,,fear=0.1", "expression: emotion mix \"anger=0.5,,fear=0.1\": part 2 is empty"},
+        {"anger=0.5,", "expression: emotion mix \"anger=0.5,\": part 2 is empty"},
+        {"anger=abc", "expression: emotion mix \"anger=abc\": part 1 (\"anger=abc\"): \"abc\" is not a number"},
+        {"anger=", "expression: emotion mix \"anger=\": part 1 (\"anger=\"): expected \"name=weight\", \"weight "
+                   "name\" or \"name\""},
+        {"anger 0.7", "expression: emotion mix \"anger 0.7\": part 1 (\"anger 0.7\"): expected \"weight name\", the "
+                      "name comes last"},
+        {"0.3 0.4 fear", "expression: emotion mix \"0.3 0.4 fear\": part 1 (\"0.3 0.4 fear\"): expected "
+                         "\"name=weight\", \"weight name\" or \"name\""},
+        {"anger=nan", "expression: emotion mix \"anger=nan\": part 1 (\"anger=nan\"): \"nan\" is not a number"},
+    };
+    for (const Case& c : cases) {
+        try {
+            parse_emotion_mix(c.text);
+            ADD_FAILURE() << "accepted \"" << c.text << "\"";
+        } catch (const InputError& e) {
+            EXPECT_EQ(std::string(e.what()), c.message);
+        }
+    }
+}
+
+TEST(EmotionMix, NormalisesWhenAsked) {
+    const EmotionMix m = parse_emotion_mix("anger=0.8,fear=0.8", true);
+    EXPECT_NEAR(m[Emotion::Anger], 0.5, 1e-12);
+    EXPECT_NEAR(m[Emotion::Fear], 0.5, 1e-12);
+    const EmotionMix n = parse_emotion_mix("1 joy + 1 neutral", true);
+    EXPECT_NEAR(n[Emotion::Joy], 0.5, 1e-12);
+    EXPECT_NEAR(n.neutral(), 0.5, 1e-12);
+    // Below 1 nothing changes.
+    EXPECT_NEAR(parse_emotion_mix("joy=0.3", true)[Emotion::Joy], 0.3, 1e-12);
+}
+
+TEST(EmotionMix, ToStringReadsBack) {
+    EXPECT_EQ(EmotionMix{}.to_string(), "neutral");
+    const EmotionMix m = mix({{Emotion::Anger, 0.7}, {Emotion::Fear, 0.3}});
+    EXPECT_EQ(m.to_string(), "0.7 anger + 0.3 fear");
+    EXPECT_EQ(parse_emotion_mix(m.to_string()), m);
+    EXPECT_EQ(find_emotion("Happiness"), Emotion::Joy);
+    EXPECT_FALSE(find_emotion("joyful"));
+    for (Emotion e : kEmotions) EXPECT_EQ(find_emotion(emotion_name(e)), e);
+}
+
+TEST(Profiles, EmotionProfilesLoadWithReasoningAndDiffer) {
+    const EmotionProfiles p = load_emotion_profiles(std::string(EMOFACE_DATA_DIR) + "/expression/emotions.json");
+    for (Emotion e : kEmotions) {
+        SCOPED_TRACE(emotion_name(e));
+        EXPECT_GT(p.reasoning[emotion_index(e)].size(), 100u);
+        EXPECT_EQ(p[e][0], 0.0);
+        EXPECT_EQ(p[e][1], 0.0);
+    }
+    // Signs the thesis (chapter 2.3) asks for.
+    auto at = [&](Emotion e, int fap) { return p[e][fap - 1]; };
+    EXPECT_GT(at(Emotion::Joy, 59), 0);        // lip corners up
+    EXPECT_LT(at(Emotion::Sadness, 59), 0);    // corners down
+    EXPECT_GT(at(Emotion::Sadness, 31), 0);    // inner brows up
+    EXPECT_LT(at(Emotion::Anger, 31), 0);      // inner brows down
+    EXPECT_GT(at(Emotion::Anger, 37), 0);      // and together
+    EXPECT_GT(at(Emotion::Fear, 31), 0);       // brows up
+    EXPECT_GT(at(Emotion::Disgust, 19), 0);    // eyes nearly closed
+    EXPECT_LT(at(Emotion::Disgust, 4), 0);     // upper lip raised
+    EXPECT_GT(at(Emotion::Surprise, 33), 0);   // brows as high as they go
+    EXPECT_LT(at(Emotion::Surprise, 19), 0);   // lids wide open
+    EXPECT_GT(at(Emotion::Surprise, 3), 0);    // mouth open
+    const EmotionMix m = mix({{Emotion::Anger, 0.7}, {Emotion::Fear, 0.3}});
+    const FapValues f = p.faps(m);
+    EXPECT_NEAR(f[31 - 1], 0.7 * at(Emotion::Anger, 31) + 0.3 * at(Emotion::Fear, 31), 1e-9);
+}
+
+TEST(Profiles, VisemesAreMouthOnlyAndBlend) {
+    const VisemeProfiles v = load_viseme_profiles(std::string(EMOFACE_DATA_DIR) + "/expression/visemes.json");
+    for (int code = 1; code < kVisemeCount; ++code) {
+        bool any = false;
+        for (int f = 1; f <= fap::kFapCount; ++f) {
+            if (v.profiles[code][f - 1] == 0.0) continue;
+            any = true;
+            EXPECT_TRUE(is_mouth_fap(f)) << "viseme " << code << " FAP " << f;
+        }
+        EXPECT_TRUE(any) << code;
+    }
+    // A: opens the jaw wider than p b m, which closes the lips.
+    EXPECT_GT(v.profiles[10][3 - 1], v.profiles[1][3 - 1]);
+    EXPECT_GT(v.profiles[1][5 - 1], 0);
+    const FapValues half = v.faps({10, 1, 21, 0});  // 1/3 of viseme 10, 2/3 of viseme 1
+    for (int f = 0; f < fap::kFapCount; ++f)
+        EXPECT_NEAR(half[f], v.profiles[10][f] / 3.0 + v.profiles[1][f] * 2.0 / 3.0, 1e-9);
+    const FapValues none = v.faps({0, 99, 63, 0});
+    for (double x : none) EXPECT_EQ(x, 0.0);
+}
+
+TEST(Profiles, BadFilesNameTheEntry) {
+    const auto dir = std::filesystem::temp_directory_path() / "emoface_profiles_test";
+    std::filesystem::create_directories(dir);
+    const std::string path = (dir / "emotions.json").string();
+    auto write_and_load = [&](const std::string& text) {
+        std::ofstream(path) << text;
+        try {
+            load_emotion_profiles(path);
+        } catch (const InputError& e) {
+            return std::string(e.what());
+        }
+        return std::string("(no error)");
+    };
+    const std::string five =
+        R"("joy": {"reasoning": "r", "faps": {}}, "sadness": {"reasoning": "r", "faps": {}},
+           "anger": {"reasoning": "r", "faps": {}}, "fear": {"reasoning": "r", "faps": {}},
+           "disgust": {"reasoning": "r", "faps": {}})";
+    EXPECT_EQ(write_and_load("{\"emotions\": {" + five + "}}"),
+              "expression: " + path + ": missing key \"emotions.surprise\"");
+    EXPECT_EQ(write_and_load("{\"emotions\": {" + five + R"(, "surprise": {"reasoning": "r", "faps": {"open_jaws": 3}}}})"),
+              "expression: " + path + ": emotions.surprise.faps: \"open_jaws\" is not a FAP name or number");
+    EXPECT_EQ(write_and_load("{\"emotions\": {" + five + R"(, "surprise": {"reasoning": "r", "faps": {"2": 3}}}})"),
+              "expression: " + path + ": emotions.surprise.faps: FAP 2 (expression) is not allowed here; expected a "
+                                      "low-level FAP (3..68)");
+    EXPECT_EQ(write_and_load("{\"emotions\": {" + five + R"(, "surprise": {"reasoning": "r", "faps": {"3": "x"}}}})"),
+              "expression: " + path + ": emotions.surprise.faps: the value of \"3\" must be a number");
+    EXPECT_EQ(write_and_load("{\"emotions\": {" + five +
+                             R"(, "surprise": {"reasoning": "r", "faps": {"3": 1, "open_jaw": 2}}}})"),
+              "expression: " + path + ": emotions.surprise.faps: FAP 3 is given twice");
+    EXPECT_EQ(write_and_load("{\"emotions\": {" + five + R"(, "surprise": {"reasoning": "r", "faps": {}, "x": 1}}})"),
+              "expression: " + path + ": unknown key \"emotions.surprise.x\"");
+    std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace emoface::expression

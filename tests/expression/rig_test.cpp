@@ -1,0 +1,266 @@
+// The FAP rig on the default face: every FAP moves its feature point by value
+// x FAPU along the FAP table's direction and leaves distant skin alone; the
+// jaw opens the lips, the lids close onto each other, the head turns.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "emoface/common/error.h"
+#include "emoface/fap/fap_table.h"
+#include "emoface/fap/feature_points.h"
+#include "test_face.h"
+
+namespace emoface::expression {
+namespace {
+
+using testing::distance;
+using testing::fp;
+using testing::test_face;
+using testing::test_rig;
+using testing::to_vec;
+
+Vec3d sub(const Vec3d& a, const Vec3d& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+double dot(const Vec3d& a, const std::array<float, 3>& d) { return a[0] * d[0] + a[1] * d[1] + a[2] * d[2]; }
+double norm(const Vec3d& a) { return std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]); }
+
+bool is_rotation(int f) { return (f >= 23 && f <= 26) || (f >= 48 && f <= 50); }
+
+// A value that moves about 2-5 mm on the default face.
+double test_value(int f) {
+    switch (fap::fap_info(f).unit) {
+        case fap::FapUnit::IRISD: return 300;
+        case fap::FapUnit::ES:
+        case fap::FapUnit::MW: return 60;
+        case fap::FapUnit::AU: return 5000;  // 0.05 rad
+        default: return 150;
+    }
+}
+
+TEST(Rig, EveryLowLevelFapHasAnEffectOnTheDefaultFace) {
+    int with_effect = 0;
+    for (int f = 3; f <= fap::kFapCount; ++f) {
+        EXPECT_TRUE(test_rig().has_effect(f)) << f << ": " << test_rig().why_no_effect(f);
+        with_effect += test_rig().has_effect(f);
+    }
+    EXPECT_EQ(with_effect, fap::kLowLevelFapCount);
+    EXPECT_FALSE(test_rig().has_effect(1));
+    EXPECT_FALSE(test_rig().why_no_effect(2).empty());
+    EXPECT_THROW(test_rig().has_effect(69), Error);
+}
+
+TEST(Rig, NoFapsIsTheNeutralFace) {
+    const DeformedFace d = test_rig().deform(FapValues{});
+    const Face& f = test_face();
+    ASSERT_EQ(static_cast<int>(d.positions.size()), f.vertex_count());
+    for (int v = 0; v < f.vertex_count(); ++v) ASSERT_EQ(d.positions[v], f.mesh.point(TriMesh::VertexHandle(v)));
+    for (int k = 0; k < fap::kFeaturePointCount; ++k) EXPECT_EQ(d.feature_points[k], f.feature_points[k].position);
+}
+
+// Table-driven over every FAP with a feature point: value x FAPU along the
+// table's direction, and nothing moves beyond the FAP's reach.
+class EachFap : public ::testing::TestWithParam<int> {};
+
+TEST_P(EachFap, MovesItsFeaturePointAlongTheTableDirectionAndNothingFar) {
+    const int f = GetParam();
+    const Face& face = test_face();
+    const auto& info = fap::fap_info(f);
+    const int k = fap::feature_point_index(info.feature_point);
+    const double value = test_value(f);
+    FapValues faps{};
+    faps[f - 1] = value;
+    const DeformedFace d = test_rig().deform(faps);
+    const Vec3d moved = sub(d.feature_points[k], face.position(k));
+    const double es0 = face.fapu.es * 1024;
+
+    double expected = value * face.fapu.of(info.unit);
+    if (is_rotation(f)) {
+        // A small rotation moves the front of the eye or face along the
+        // direction by about angle x the lever's depth in front of the
+        // centre (for roll: the crown, by angle x its height above it).
+        const double angle = value * face.fapu.au;
+        const bool roll = f == 50;
+        const int point = roll ? fp("11.4") : f >= 48 ? fp("9.3") : k;
+        const Vec3d centre = f >= 48 ? face.head_pivot : face.eyeballs[f % 2 == 1 ? 0 : 1].centre;
+        const Vec3d pos = face.position(point);
+        const Vec3d lever = sub(pos, centre);
+        expected = angle * (roll ? lever[1] : lever[2]);
+        EXPECT_NEAR(dot(sub(d.feature_points[point], pos), info.direction), expected, 0.03 * expected);
+    } else if (f == 3) {
+        // open_jaw rotates the jaw: the chin drops by exactly value x MNS
+        // and swings back (its lever hangs below the jaw joint).
+        EXPECT_NEAR(dot(moved, info.direction), expected, 1e-3);
+        EXPECT_LT(moved[2], 0.0);
+    } else if (f == 29 || f == 30) {
+        // Pupil dilation: the pupil centre stays, the iris ring widens.
+        EXPECT_LT(norm(moved), 1e-6);
+        const Eyeball& e = face.eyeballs[f == 29 ? 0 : 1];
+        int wider = 0;
+        for (int v = e.vertices.first; v < e.vertices.end(); ++v) {
+            const Vec3d a = sub(to_vec(face.mesh.point(TriMesh::VertexHandle(v))), e.centre);
+            const Vec3d b = sub(to_vec(d.positions[v]), e.centre);
+            const double pa = std::acos(std::clamp(a[2] / norm(a), -1.0, 1.0));
+            const double pb = std::acos(std::clamp(b[2] / norm(b), -1.0, 1.0));
+            EXPECT_GE(pb, pa - 1e-5);
+            wider += pb > pa + 1e-4;
+        }
+        EXPECT_GT(wider, 10);
+    } else if (f == 47) {
+        // Tongue roll curls both borders up.
+        EXPECT_GT(moved[1], 0.1);
+        EXPECT_GT(d.feature_points[fp("6.4")][1] - face.position(fp("6.4"))[1], 0.1);
+    } else {
+        const double along = dot(moved, info.direction);
+        EXPECT_NEAR(along, expected, 0.02 * std::abs(expected) + 1e-4);
+        Vec3d across = moved;
+        for (int c = 0; c < 3; ++c) across[c] -= along * info.direction[c];
+        // Lids slide over the eyeball, which moves them in z as well.
+        const double allowed = (f >= 19 && f <= 22) ? 0.7 : 0.05;
+        EXPECT_LT(norm(across), allowed * std::abs(expected) + 1e-4);
+    }
+
+    // Far from the FAP's region nothing moves.
+    Vec3d origin = face.position(k);
+    double reach = std::max(test_rig().influence_radius(k), 0.35 * es0) + 0.5;
+    bool skip_far = false;
+    if (f == 3 || f == 14 || f == 15) {
+        skip_far = true;  // checked below: the head above the mouth stays
+        for (int v = 0; v < face.vertex_count(); ++v) {
+            const auto p = face.mesh.point(TriMesh::VertexHandle(v));
+            if (p[1] > face.position(fp("3.5"))[1]) ASSERT_EQ(d.positions[v], p) << "vertex " << v;
+        }
+    } else if (f >= 23 && f <= 30) {
+        skip_far = true;  // eyeball FAPs move only their eyeball
+        const Eyeball& e = face.eyeballs[f % 2 == 1 ? 0 : 1];
+        for (int v = 0; v < face.vertex_count(); ++v)
+            if (!e.vertices.contains(v)) ASSERT_EQ(d.positions[v], face.mesh.point(TriMesh::VertexHandle(v))) << "vertex " << v;
+    } else if (f >= 48) {
+        skip_far = true;  // the head turns; the neck's cut stays
+        int still = 0;
+        for (int v = 0; v < face.vertex_count(); ++v)
+            if (face.mesh.point(TriMesh::VertexHandle(v))[1] < face.head_pivot[1] - es0) {
+                ASSERT_EQ(d.positions[v], face.mesh.point(TriMesh::VertexHandle(v)));
+                ++still;
+            }
+        EXPECT_GT(still, 50);
+    }
+    if (!skip_far) {
+        int far = 0;
+        // Tongue roll moves both tongue borders.
+        const Vec3d other = f == 47 ? face.position(fp("6.4")) : origin;
+        for (int v = 0; v < face.vertex_count(); ++v) {
+            const Vec3d p = to_vec(face.mesh.point(TriMesh::VertexHandle(v)));
+            if (distance(p, origin) <= reach || distance(p, other) <= reach) continue;
+            ++far;
+            ASSERT_LT(distance(to_vec(d.positions[v]), p), 1e-4) << "vertex " << v << " at distance " << distance(p, origin);
+        }
+        EXPECT_GT(far, face.vertex_count() / 2);
+    }
+}
+
+std::vector<int> faps_with_points() {
+    std::vector<int> out;
+    for (int f = 3; f <= fap::kFapCount; ++f) out.push_back(f);
+    return out;
+}
+INSTANTIATE_TEST_SUITE_P(DefaultFace, EachFap, ::testing::ValuesIn(faps_with_points()),
+                         [](const ::testing::TestParamInfo<int>& i) {
+                             return std::to_string(i.param) + "_" + std::string(fap::fap_info(i.param).name);
+                         });
+
+TEST(Rig, OpenJaw512OpensAGapBetweenTheLips) {
+    const Face& face = test_face();
+    FapValues faps{};
+    faps[3 - 1] = 512;
+    const DeformedFace d = test_rig().deform(faps);
+    const double gap = d.feature_points[fp("2.2")][1] - d.feature_points[fp("2.3")][1];
+    // The lower lip rides on the jaw: at least 60 % of the chin's drop.
+    EXPECT_GT(gap, 0.6 * 512 * face.fapu.mns);
+    // The upper lip stays; every lower-lip slit vertex is below its upper twin.
+    EXPECT_LT(distance(d.feature_points[fp("2.2")], face.position(fp("2.2"))), 1e-4);
+    EXPECT_LT(d.feature_points[fp("2.8")][1], d.feature_points[fp("2.6")][1] - 2.0);
+    EXPECT_LT(d.feature_points[fp("2.9")][1], d.feature_points[fp("2.7")][1] - 2.0);
+    // Teeth part: the lower incisors follow the jaw.
+    EXPECT_LT(d.feature_points[fp("9.11")][1], face.position(fp("9.11"))[1] - 3.0);
+    EXPECT_LT(distance(d.feature_points[fp("9.10")], face.position(fp("9.10"))), 1e-4);
+}
+
+TEST(Rig, ClosingEyelids1024PutsUpperOnLowerAlongTheWholeMargin) {
+    const Face& face = test_face();
+    FapValues faps{};
+    faps[19 - 1] = faps[20 - 1] = 1024;
+    const DeformedFace d = test_rig().deform(faps);
+    for (int side = 0; side < 2; ++side) {
+        SCOPED_TRACE(side);
+        const int up = fp(side == 0 ? "3.1" : "3.2"), lo = fp(side == 0 ? "3.3" : "3.4");
+        EXPECT_NEAR(d.feature_points[up][1], d.feature_points[lo][1], 1e-3);
+        EXPECT_LT(distance(d.feature_points[up], d.feature_points[lo]), 0.3);
+        const Eyeball& e = face.eyeballs[side];
+        for (std::size_t i = 0; i < e.upper_margin.size(); ++i) {
+            const Vec3d a = to_vec(d.positions[e.upper_margin[i]]), b = to_vec(d.positions[e.lower_margin[i]]);
+            EXPECT_LT(distance(a, b), 0.5) << "margin vertex " << i;
+            // The lid slid over the eyeball, not through it.
+            EXPECT_GE(distance(a, e.centre), e.radius);
+        }
+    }
+}
+
+TEST(Rig, UpperLipFapsDoNotDragTheLowerLip) {
+    const Face& face = test_face();
+    for (int f : {4, 8, 9, 17, 51, 55, 56}) {
+        FapValues faps{};
+        faps[f - 1] = 300;
+        const DeformedFace d = test_rig().deform(faps);
+        for (const char* id : {"2.3", "2.8", "2.9", "8.2", "8.7", "8.8"})
+            EXPECT_LT(distance(d.feature_points[fp(id)], face.position(fp(id))), 1e-5) << "FAP " << f << " moved " << id;
+    }
+    for (int f : {5, 10, 11, 16, 52, 57, 58}) {
+        FapValues faps{};
+        faps[f - 1] = 300;
+        const DeformedFace d = test_rig().deform(faps);
+        for (const char* id : {"2.2", "2.6", "2.7", "8.1", "8.5", "8.6"})
+            EXPECT_LT(distance(d.feature_points[fp(id)], face.position(fp(id))), 1e-5) << "FAP " << f << " moved " << id;
+    }
+}
+
+TEST(Rig, HeadPitchTiltsTheWholeHeadForward) {
+    const Face& face = test_face();
+    FapValues faps{};
+    faps[48 - 1] = 10000;  // 0.1 rad, "down"
+    const DeformedFace d = test_rig().deform(faps);
+    const Vec3d nose = sub(d.feature_points[fp("9.3")], face.position(fp("9.3")));
+    const Vec3d crown = sub(d.feature_points[fp("11.4")], face.position(fp("11.4")));
+    EXPECT_LT(nose[1], -5.0);  // the face goes down
+    EXPECT_GT(crown[2], 5.0);  // the top of the head goes forward
+    // Distances within the head are kept (a rotation).
+    EXPECT_NEAR(distance(d.feature_points[fp("3.5")], d.feature_points[fp("3.6")]),
+                distance(face.position(fp("3.5")), face.position(fp("3.6"))), 1e-3);
+    // 7.1 is the pivot.
+    EXPECT_LT(distance(d.feature_points[fp("7.1")], face.position(fp("7.1"))), 1e-9);
+}
+
+TEST(Rig, WriteToUpdatesPointsAndNormals) {
+    const Face& face = test_face();
+    FapValues faps{};
+    faps[49 - 1] = 20000;  // yaw 0.2 rad to the left
+    const DeformedFace d = test_rig().deform(faps);
+    TriMesh mesh = face.mesh;
+    FaceRig::write_to(d, mesh);
+    const TriMesh::VertexHandle tip(face.feature_points[fp("9.3")].vertex);
+    EXPECT_EQ(mesh.point(tip), d.positions[tip.idx()]);
+    EXPECT_GT(mesh.normal(tip)[0], face.mesh.normal(tip)[0] + 0.1f);
+    DeformedFace wrong;
+    EXPECT_THROW(FaceRig::write_to(wrong, mesh), Error);
+}
+
+TEST(Rig, FeaturePointsMatchTheFullDeformation) {
+    FapValues faps{};
+    faps[3 - 1] = 200;
+    faps[33 - 1] = 150;
+    faps[59 - 1] = 100;
+    const auto fps = test_rig().feature_points(faps);
+    const DeformedFace d = test_rig().deform(faps);
+    for (int k = 0; k < fap::kFeaturePointCount; ++k) EXPECT_EQ(fps[k], d.feature_points[k]);
+}
+
+}  // namespace
+}  // namespace emoface::expression

@@ -1,0 +1,418 @@
+// The wrinkle library (issue 5): feature lines, layouts, and the generated
+// normal maps -- valid, where thesis chapter 2.3 puts them, locked to the
+// features under the morph, deterministic and resolution-independent.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+
+#include <glm/glm.hpp>
+
+#include "emoface/common/error.h"
+#include "emoface/expression/feature_layout.h"
+#include "emoface/expression/profiles.h"
+#include "emoface/expression/wrinkle_map.h"
+#include "emoface/morph/morph.h"
+#include "test_face.h"
+
+namespace emoface::expression {
+namespace {
+
+using testing::data_dir;
+
+const WrinkleLibrarySpec& spec() {
+    static const WrinkleLibrarySpec s = load_wrinkle_spec(data_dir() + "/expression/wrinkles.json");
+    return s;
+}
+
+std::bitset<kFeatureCount> present_points(const Face& face) {
+    std::bitset<kFeatureCount> present;
+    for (int i = 0; i < kFeatureCount; ++i) present[i] = face.has(i);
+    return present;
+}
+
+// The layout of the default face at each key's full intensity.
+const FeatureLayout& key_layout(WrinkleKey key) {
+    static const std::array<FeatureLayout, kWrinkleKeyCount> layouts = [] {
+        const Face& face = testing::test_face();
+        const EmotionProfiles profiles = load_emotion_profiles(data_dir() + "/expression/emotions.json");
+        std::array<FeatureLayout, kWrinkleKeyCount> out;
+        for (int k = 0; k < kWrinkleKeyCount; ++k) {
+            FapValues pose{};
+            if (k > 0) pose = profiles[static_cast<Emotion>(k)];
+            out[k] = projective_layout(testing::test_rig().feature_points(pose), present_points(face),
+                                       face.texture_box);
+        }
+        return out;
+    }();
+    return layouts[static_cast<int>(key)];
+}
+
+const NormalMap& key_map(WrinkleKey key) {
+    static std::map<WrinkleKey, NormalMap> cache;
+    auto it = cache.find(key);
+    if (it == cache.end()) it = cache.emplace(key, generate_wrinkle_map(spec(), key, key_layout(key), 256)).first;
+    return it->second;
+}
+
+glm::vec3 decode(const NormalMap& map, int x, int y) {
+    const std::uint8_t* p = &map.rgba[(static_cast<size_t>(y) * map.width + x) * 4];
+    return {p[0] / 127.5f - 1.0f, p[1] / 127.5f - 1.0f, p[2] / 127.5f - 1.0f};
+}
+
+// Mean tilt away from flat, |n.x| + |n.y|, over a rectangle in normalised
+// texture coordinates.
+struct Rect {
+    glm::vec2 min, max;
+};
+float mean_tilt(const NormalMap& map, const Rect& r) {
+    double sum = 0.0;
+    int n = 0;
+    for (int y = std::max(0, int(r.min.y * map.height)); y < std::min(map.height, int(r.max.y * map.height)); ++y)
+        for (int x = std::max(0, int(r.min.x * map.width)); x < std::min(map.width, int(r.max.x * map.width)); ++x) {
+            const glm::vec3 v = decode(map, x, y);
+            sum += std::abs(v.x) + std::abs(v.y);
+            ++n;
+        }
+    return n ? static_cast<float>(sum / n) : 0.0f;
+}
+
+// Regions of the face defined by its feature points (at the key's own layout).
+enum class Region { Forehead, Glabella, EyeCorners, Nasolabial, BelowLowerLip, NoseBridge, Chin };
+const char* region_name(Region r) {
+    static const char* names[] = {"forehead", "glabella", "eye corners", "nasolabial", "below lower lip",
+                                  "nose bridge", "chin"};
+    return names[static_cast<int>(r)];
+}
+
+std::vector<Rect> region_rects(Region region, const FeatureLayout& l) {
+    const float u = l.face_unit();
+    const auto at = [&](const char* id) { return l.at(id); };
+    const auto box = [](glm::vec2 a, glm::vec2 b) { return Rect{glm::min(a, b), glm::max(a, b)}; };
+    switch (region) {
+        case Region::Forehead: {
+            const float top = std::min(at("4.3").y, at("4.4").y);
+            return {box({at("4.4").x, top - 0.75f * u}, {at("4.3").x, top - 0.18f * u})};
+        }
+        case Region::Glabella: {
+            const glm::vec2 mid = 0.5f * (at("4.1") + at("4.2"));
+            return {box(mid + u * glm::vec2(-0.12f, -0.2f), mid + u * glm::vec2(0.12f, 0.08f))};
+        }
+        case Region::EyeCorners:
+            return {box(at("3.7") + u * glm::vec2(0.06f, -0.18f), at("3.7") + u * glm::vec2(0.3f, 0.18f)),
+                    box(at("3.12") + u * glm::vec2(-0.06f, -0.18f), at("3.12") + u * glm::vec2(-0.3f, 0.18f))};
+        case Region::Nasolabial:
+            return {box(at("9.1") + u * glm::vec2(0.0f, 0.0f), at("8.3") + u * glm::vec2(0.22f, 0.05f)),
+                    box(at("9.2") + u * glm::vec2(0.0f, 0.0f), at("8.4") + u * glm::vec2(-0.22f, 0.05f))};
+        case Region::BelowLowerLip:
+            return {box(glm::vec2(at("8.4").x, at("8.2").y + 0.06f * u),
+                        glm::vec2(at("8.3").x, at("8.2").y + 0.3f * u))};
+        case Region::NoseBridge:
+            return {box(glm::vec2(at("3.8").x, at("3.11").y), glm::vec2(at("3.11").x, at("3.11").y + 0.3f * u))};
+        case Region::Chin:
+            return {box(at("2.10") + u * glm::vec2(-0.15f, -0.12f), at("2.10") + u * glm::vec2(0.15f, 0.12f))};
+    }
+    return {};
+}
+
+float region_tilt(WrinkleKey key, Region region) {
+    float sum = 0.0f;
+    const auto rects = region_rects(region, key_layout(key));
+    for (const Rect& r : rects) sum += mean_tilt(key_map(key), r);
+    return sum / static_cast<float>(rects.size());
+}
+
+// ---------------------------------------------------------------- validity
+
+class EveryKey : public ::testing::TestWithParam<WrinkleKey> {};
+
+TEST_P(EveryKey, IsAValidNormalMapFlatAwayFromWrinkles) {
+    const WrinkleKey key = GetParam();
+    const NormalMap& map = key_map(key);
+    ASSERT_EQ(map.width, 256);
+    ASSERT_EQ(map.rgba.size(), 256u * 256u * 4u);
+    const std::vector<float> height = render_height_field(spec(), key, key_layout(key), 256);
+    int flat = 0;
+    for (int y = 0; y < 256; ++y)
+        for (int x = 0; x < 256; ++x) {
+            const glm::vec3 n = decode(map, x, y);
+            // 8-bit quantisation: each component within 1/255 of the unit vector.
+            ASSERT_NEAR(glm::length(n), 1.0f, 0.012f) << "at " << x << "," << y;
+            ASSERT_GT(n.z, 0.0f) << "at " << x << "," << y;
+            bool untouched = true;
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx) {
+                    const int yy = std::clamp(y + dy, 0, 255), xx = std::clamp(x + dx, 0, 255);
+                    untouched = untouched && height[yy * 256 + xx] == 0.0f;
+                }
+            if (untouched) {
+                ++flat;
+                const std::uint8_t* p = &map.rgba[(y * 256 + x) * 4];
+                ASSERT_EQ(p[0], 128) << "at " << x << "," << y;
+                ASSERT_EQ(p[1], 128) << "at " << x << "," << y;
+                ASSERT_EQ(p[2], 255) << "at " << x << "," << y;
+            }
+        }
+    // Wrinkles are local: most of every key map is untouched skin.
+    if (key != WrinkleKey::Neutral) EXPECT_GT(flat, 256 * 256 / 2);
+}
+
+TEST_P(EveryKey, SameSpecAndSizeGiveIdenticalBytes) {
+    const WrinkleKey key = GetParam();
+    EXPECT_EQ(generate_wrinkle_map(spec(), key, key_layout(key), 256).rgba, key_map(key).rgba);
+}
+
+INSTANTIATE_TEST_SUITE_P(Wrinkles, EveryKey,
+                         ::testing::Values(WrinkleKey::Neutral, WrinkleKey::Joy, WrinkleKey::Sadness,
+                                           WrinkleKey::Anger, WrinkleKey::Fear, WrinkleKey::Disgust,
+                                           WrinkleKey::Surprise),
+                         [](const auto& info) { return std::string(wrinkle_key_name(info.param)); });
+
+// ---------------------------------------------------------------- placement
+
+// Thesis 2.3, region by region. "strong": clearly wrinkled; "weak": close to
+// flat skin. Thresholds are mean |n.x| + |n.y| over the region (a flat map
+// scores 0; a region crossed by a few clear wrinkles scores several 0.01).
+struct Placement {
+    WrinkleKey key;
+    Region region;
+    bool strong;
+};
+constexpr float kStrong = 0.02f;
+constexpr float kWeak = 0.008f;
+
+class WrinklePlacement : public ::testing::TestWithParam<Placement> {};
+
+TEST_P(WrinklePlacement, MatchesThesisChapter2_3) {
+    const Placement p = GetParam();
+    const float tilt = region_tilt(p.key, p.region);
+    if (p.strong)
+        EXPECT_GT(tilt, kStrong) << wrinkle_key_name(p.key) << " should wrinkle the " << region_name(p.region);
+    else
+        EXPECT_LT(tilt, kWeak) << wrinkle_key_name(p.key) << " should leave the " << region_name(p.region)
+                               << " smooth";
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Thesis, WrinklePlacement,
+    ::testing::Values(
+        Placement{WrinkleKey::Surprise, Region::Forehead, true},
+        Placement{WrinkleKey::Surprise, Region::Glabella, false},
+        Placement{WrinkleKey::Surprise, Region::EyeCorners, false},
+        Placement{WrinkleKey::Anger, Region::Glabella, true},
+        Placement{WrinkleKey::Anger, Region::Forehead, false},
+        Placement{WrinkleKey::Anger, Region::Nasolabial, false},
+        Placement{WrinkleKey::Joy, Region::EyeCorners, true},
+        Placement{WrinkleKey::Joy, Region::Nasolabial, true},
+        Placement{WrinkleKey::Joy, Region::Forehead, false},
+        Placement{WrinkleKey::Joy, Region::Glabella, false},
+        Placement{WrinkleKey::Sadness, Region::Forehead, true},
+        Placement{WrinkleKey::Sadness, Region::Glabella, true},
+        Placement{WrinkleKey::Sadness, Region::BelowLowerLip, true},
+        Placement{WrinkleKey::Sadness, Region::EyeCorners, false},
+        Placement{WrinkleKey::Fear, Region::Forehead, true},
+        Placement{WrinkleKey::Fear, Region::Glabella, true},
+        Placement{WrinkleKey::Fear, Region::Nasolabial, false},
+        Placement{WrinkleKey::Disgust, Region::NoseBridge, true},
+        Placement{WrinkleKey::Disgust, Region::Glabella, true},
+        Placement{WrinkleKey::Disgust, Region::Chin, true},
+        Placement{WrinkleKey::Disgust, Region::Forehead, false},
+        Placement{WrinkleKey::Neutral, Region::Forehead, false},
+        Placement{WrinkleKey::Neutral, Region::Glabella, false}),
+    [](const auto& info) {
+        std::string name = std::string(wrinkle_key_name(info.param.key)) + "_" + region_name(info.param.region);
+        for (char& c : name)
+            if (c == ' ') c = '_';
+        return name + (info.param.strong ? "_strong" : "_weak");
+    });
+
+TEST(WrinklePlacement, SurpriseAndAngerAreOpposites) {
+    EXPECT_GT(region_tilt(WrinkleKey::Surprise, Region::Forehead),
+              4.0f * region_tilt(WrinkleKey::Surprise, Region::Glabella));
+    EXPECT_GT(region_tilt(WrinkleKey::Anger, Region::Glabella),
+              4.0f * region_tilt(WrinkleKey::Anger, Region::Forehead));
+}
+
+// ---------------------------------------------------------------- morph
+
+std::vector<morph::Line> to_morph(const std::vector<Segment>& segments) {
+    std::vector<morph::Line> lines;
+    for (const Segment& s : segments) lines.push_back({s.p.x, s.p.y, s.q.x, s.q.y});
+    return lines;
+}
+
+// Tilt-weighted centroid of the wrinkles within `radius` of `centre`.
+glm::vec2 wrinkle_centroid(const std::vector<std::uint8_t>& rgba, int size, glm::vec2 centre, float radius) {
+    glm::dvec2 sum{0.0};
+    double total = 0.0;
+    for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x) {
+            const glm::vec2 p{(x + 0.5f) / size, (y + 0.5f) / size};
+            if (glm::distance(p, centre) > radius) continue;
+            const std::uint8_t* px = &rgba[(static_cast<size_t>(y) * size + x) * 4];
+            const double w = std::abs(px[0] - 127.5) + std::abs(px[1] - 127.5) - 1.0;  // 0 on flat skin
+            if (w <= 0.0) continue;
+            sum += w * glm::dvec2(p);
+            total += w;
+        }
+    return total > 0.0 ? glm::vec2(sum / total) : centre;
+}
+
+TEST(WrinkleMorph, AngerGlabellaLinesFollowTheBrowsToTheSurpriseLayout) {
+    const Face& face = testing::test_face();
+    const auto lines = lines_for_face(load_feature_lines(data_dir() + "/expression/feature_lines.json"),
+                                      present_points(face));
+    const FeatureLayout& anger = key_layout(WrinkleKey::Anger);
+    const FeatureLayout& surprise = key_layout(WrinkleKey::Surprise);
+    const NormalMap& map = key_map(WrinkleKey::Anger);
+
+    morph::Morpher morpher(256, 256, morph::PixelFormat::Rgba8,
+                           {morph::KeyMap{map.rgba.data(), to_morph(layout_segments(lines, anger))}},
+                           morph::Backend::Cpu);
+    morph::MorphParams params;
+    params.normal_map = true;
+    std::vector<std::uint8_t> out(map.rgba.size());
+    morpher.morph_to_host(to_morph(layout_segments(lines, surprise)), {1.0f}, params, out.data());
+
+    const glm::vec2 brows_before = 0.5f * (anger.at("4.1") + anger.at("4.2"));
+    const glm::vec2 brows_after = 0.5f * (surprise.at("4.1") + surprise.at("4.2"));
+    const float radius = 0.3f * anger.face_unit();
+    const glm::vec2 before = wrinkle_centroid(map.rgba, 256, brows_before, radius);
+    const glm::vec2 after = wrinkle_centroid(out, 256, brows_after, radius);
+    const glm::vec2 brow_shift = brows_after - brows_before;
+    ASSERT_GT(glm::length(brow_shift), 4.0f / 256) << "the inner brows must move between the two layouts";
+    // The lines travel with the inner brows: same shift, within a quarter of it
+    // plus a pixel and a half.
+    EXPECT_LT(glm::distance(after - before, brow_shift), 0.25f * glm::length(brow_shift) + 1.5f / 256)
+        << "wrinkles moved by (" << (after - before).x << ", " << (after - before).y << "), brows by ("
+        << brow_shift.x << ", " << brow_shift.y << ")";
+}
+
+// ---------------------------------------------------------------- sizes
+
+TEST(WrinkleSizes, DifferentSizesAgreeWhenDownsampled) {
+    const FeatureLayout& layout = key_layout(WrinkleKey::Surprise);
+    const NormalMap small = generate_wrinkle_map(spec(), WrinkleKey::Surprise, layout, 256);
+    const NormalMap large = generate_wrinkle_map(spec(), WrinkleKey::Surprise, layout, 1024);
+    double sum = 0.0;
+    float worst = 0.0f;
+    for (int y = 0; y < 256; ++y)
+        for (int x = 0; x < 256; ++x) {
+            glm::vec3 mean{0.0f};
+            for (int dy = 0; dy < 4; ++dy)
+                for (int dx = 0; dx < 4; ++dx) mean += decode(large, 4 * x + dx, 4 * y + dy);
+            const float d = glm::distance(glm::normalize(mean), decode(small, x, y));
+            sum += d;
+            worst = std::max(worst, d);
+        }
+    // Heights are defined in normalised units, so the maps sample one surface;
+    // the 256 map point-samples what the 1024 one averages over 4x4 pixels.
+    EXPECT_LT(sum / (256 * 256), 0.01);
+    EXPECT_LT(worst, 0.35f);
+}
+
+TEST(WrinkleSizes, RejectsSizesOutsideTheRange) {
+    const FeatureLayout& layout = key_layout(WrinkleKey::Joy);
+    EXPECT_THROW(generate_wrinkle_map(spec(), WrinkleKey::Joy, layout, 128), InputError);
+    EXPECT_THROW(generate_wrinkle_map(spec(), WrinkleKey::Joy, layout, 8192), InputError);
+}
+
+// ---------------------------------------------------------------- spec and lines
+
+struct BadSpec {
+    const char* name;
+    const char* json;
+    const char* message;
+};
+
+class WrinkleSpecErrors : public ::testing::TestWithParam<BadSpec> {};
+
+TEST_P(WrinkleSpecErrors, NameTheProblem) {
+    const std::string path = ::testing::TempDir() + "/bad_wrinkles_" + GetParam().name + ".json";
+    std::ofstream(path) << GetParam().json;
+    try {
+        load_wrinkle_spec(path);
+        FAIL() << "expected an error";
+    } catch (const InputError& e) {
+        EXPECT_EQ(std::string(e.what()), "expression: " + path + ": " + GetParam().message);
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Table, WrinkleSpecErrors,
+    ::testing::Values(
+        BadSpec{"no_emotions", R"({"x": 1})", "expected an object \"emotions\", found none"},
+        BadSpec{"unknown_emotion", R"({"emotions": {"boredom": []}})",
+                "unknown emotion \"boredom\" (expected neutral, joy, sadness, anger, fear, disgust or surprise)"},
+        BadSpec{"no_points", R"({"emotions": {"joy": [{"name": "a"}]}})",
+                "joy, wrinkle 1 (a): expected an object with a non-empty \"points\" list"},
+        BadSpec{"unknown_point", R"({"emotions": {"joy": [{"name": "a", "points": [{"fp": "12.1"}]}]}})",
+                "joy, wrinkle 1 (a): unknown feature point \"12.1\""},
+        BadSpec{"bad_profile",
+                R"({"emotions": {"anger": [{"name": "b", "profile": "zigzag", "points": [{"fp": "4.1"}]}]}})",
+                "anger, wrinkle 1 (b): profile must be groove, fold, bulge or dimple, found \"zigzag\""},
+        BadSpec{"negative_depth",
+                R"({"emotions": {"fear": [{"name": "c", "depth": -1, "points": [{"fp": "4.1"}]}]}})",
+                "fear, wrinkle 1 (c): \"depth\" must be a number in [0, 1], found -1"},
+        BadSpec{"bad_offset",
+                R"({"emotions": {"fear": [{"name": "d", "points": [{"fp": "4.1", "offset": [1]}]}]}})",
+                "fear, wrinkle 1 (d): \"offset\" must be [x, y], found [1]"}),
+    [](const auto& info) { return std::string(info.param.name); });
+
+TEST(FeatureLines, TheShippedSetCoversTheFaceWithUsableLines) {
+    const auto lines = load_feature_lines(data_dir() + "/expression/feature_lines.json");
+    EXPECT_GE(lines.size(), 40u);
+    EXPECT_LE(lines.size(), 100u);
+    std::set<std::string> regions;
+    for (const FeatureLine& l : lines) regions.insert(l.region);
+    for (const char* r : {"brows", "upper eyelids", "lower eyelids", "nose bridge", "nose wings", "outer lips",
+                          "inner lips", "cheeks", "chin and jaw", "forehead and hairline"})
+        EXPECT_TRUE(regions.count(r)) << "no lines for " << r;
+    // On the default face every line has both end points and a length in
+    // every key layout (the morph rejects zero-length key lines).
+    const auto usable = lines_for_face(lines, present_points(testing::test_face()));
+    EXPECT_EQ(usable.size(), lines.size());
+    for (int k = 0; k < kWrinkleKeyCount; ++k)
+        for (const Segment& s : layout_segments(usable, key_layout(static_cast<WrinkleKey>(k))))
+            EXPECT_GT(glm::distance(s.p, s.q), 1e-3f) << wrinkle_key_name(static_cast<WrinkleKey>(k));
+}
+
+TEST(FeatureLines, LinesAFaceLacksAreDroppedAndShortOnesCollapse) {
+    const std::vector<FeatureLine> lines = {{fap::feature_point_index("4.1"), fap::feature_point_index("4.3"), ""},
+                                            {fap::feature_point_index("6.1"), fap::feature_point_index("6.2"), ""},
+                                            {fap::feature_point_index("2.2"), fap::feature_point_index("2.3"), ""}};
+    std::bitset<kFeatureCount> present;
+    for (const char* id : {"4.1", "4.3", "2.2", "2.3"}) present[fap::feature_point_index(id)] = true;
+    const auto kept = lines_for_face(lines, present);
+    ASSERT_EQ(kept.size(), 2u);  // the tongue line is gone
+    FeatureLayout layout;
+    layout.present = present;
+    layout.points[fap::feature_point_index("4.1")] = {0.4f, 0.3f};
+    layout.points[fap::feature_point_index("4.3")] = {0.3f, 0.28f};
+    // A closed mouth: the inner lip mid points coincide.
+    layout.points[fap::feature_point_index("2.2")] = {0.5f, 0.7f};
+    layout.points[fap::feature_point_index("2.3")] = {0.5f, 0.7f + 1e-6f};
+    const auto segments = layout_segments(kept, layout);
+    ASSERT_EQ(segments.size(), 2u);
+    EXPECT_NE(segments[0].p, segments[0].q);
+    EXPECT_EQ(segments[1].p, segments[1].q);
+    EXPECT_TRUE(std::isfinite(segments[1].p.x) && std::isfinite(segments[1].p.y));
+}
+
+TEST(FeatureLayouts, RoundTripThroughJson) {
+    const FeatureLayout& layout = key_layout(WrinkleKey::Fear);
+    const FeatureLayout back = layout_from_json(layout_to_json(layout), "test");
+    EXPECT_EQ(back.present, layout.present);
+    for (int i = 0; i < kFeatureCount; ++i)
+        if (layout.present[i]) {
+            EXPECT_NEAR(back.points[i].x, layout.points[i].x, 1e-6f);
+            EXPECT_NEAR(back.points[i].y, layout.points[i].y, 1e-6f);
+        }
+    EXPECT_THROW(layout_from_json(R"({"points": {"4.1": [0.5]}})", "x.json"), InputError);
+    EXPECT_THROW(layout_from_json(R"({"points": {"99.1": [0.5, 0.5]}})", "x.json"), InputError);
+}
+
+}  // namespace
+}  // namespace emoface::expression
