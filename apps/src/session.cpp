@@ -1,0 +1,341 @@
+#include "session.h"
+
+#include <algorithm>
+#include <bitset>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <future>
+#include <thread>
+
+#include <fmt/format.h>
+#include <glm/mat4x4.hpp>
+#include <glm/vec4.hpp>
+#include <spdlog/spdlog.h>
+
+#include "emoface/common/error.h"
+#include "emoface/expression/default_face.h"
+#include "emoface/expression/face_io.h"
+#include "emoface/fap/fap_io.h"
+#include "emoface/render/image_io.h"
+
+namespace emoface::apps {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+bool ends_with(const std::string& s, const std::string& suffix) {
+    if (s.size() < suffix.size()) return false;
+    return std::equal(suffix.rbegin(), suffix.rend(), s.rbegin(), [](char a, char b) {
+        return std::tolower(static_cast<unsigned char>(a)) == std::tolower(static_cast<unsigned char>(b));
+    });
+}
+
+void add_times(render::FrameStageTimes& a, const render::FrameStageTimes& b, double scale = 1.0) {
+    a.rig_ms += scale * b.rig_ms;
+    a.layout_ms += scale * b.layout_ms;
+    a.morph_ms += scale * b.morph_ms;
+    a.uv_ms += scale * b.uv_ms;
+    a.tangents_ms += scale * b.tangents_ms;
+    a.upload_ms += scale * b.upload_ms;
+}
+
+}  // namespace
+
+// --- small shared helpers ---------------------------------------------------
+
+void FrameTimeTotals::add(const FrameTimes& t) {
+    add_times(sum.scene, t.scene);
+    sum.draw_ms += t.draw_ms;
+    sum.readback_ms += t.readback_ms;
+    sum.total_ms += t.total_ms;
+    ++frames;
+}
+
+FrameTimes FrameTimeTotals::mean() const {
+    FrameTimes m;
+    if (frames == 0) return m;
+    const double s = 1.0 / frames;
+    add_times(m.scene, sum.scene, s);
+    m.draw_ms = sum.draw_ms * s;
+    m.readback_ms = sum.readback_ms * s;
+    m.total_ms = sum.total_ms * s;
+    return m;
+}
+
+std::string format_times(const LoadTimes& load, const FrameTimeTotals& frames) {
+    std::string out = fmt::format(
+        "  load ({:.0f} ms): face {:.0f}, rig {:.0f}, profiles+lines {:.0f}, 7 wrinkle keys {:.0f}, "
+        "GL context {:.0f}, scene {:.0f}\n",
+        load.total(), load.face_ms, load.rig_ms, load.profiles_ms, load.keys_ms, load.platform_ms,
+        load.scene_ms);
+    if (frames.frames > 0) {
+        const FrameTimes m = frames.mean();
+        out += fmt::format(
+            "  per frame (mean of {}, {:.1f} ms = {:.1f} frames/s): rig {:.2f}, layout {:.2f}, "
+            "morph {:.2f}, wrinkle UVs {:.2f}, tangents {:.2f}, upload {:.2f}, draw {:.2f}, "
+            "read back {:.2f}\n",
+            frames.frames, m.total_ms, m.total_ms > 0 ? 1000.0 / m.total_ms : 0.0, m.scene.rig_ms,
+            m.scene.layout_ms, m.scene.morph_ms, m.scene.uv_ms, m.scene.tangents_ms,
+            m.scene.upload_ms, m.draw_ms, m.readback_ms);
+    }
+    return out;
+}
+
+fap::FapStream load_fap_stream(const std::string& path) {
+    if (!std::filesystem::is_regular_file(path))
+        fail<InputError>("fap: {}: no such file", path);
+    fap::FapStream stream = fap::read_fap_file(path);
+    if (stream.frames.empty()) fail<InputError>("fap: {}: the file has no frames", path);
+    if (!(stream.fps > 0)) fail<InputError>("fap: {}: frame rate {} is not positive", path, stream.fps);
+    return stream;
+}
+
+std::pair<int, int> parse_size(const std::string& text, const std::string& command,
+                               const std::string& option) {
+    int w = 0, h = 0;
+    char x = 0, extra = 0;
+    if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X') ||
+        w < 16 || h < 16 || w > 8192 || h > 8192)
+        fail<InputError>("{}: {} '{}': expected WIDTHxHEIGHT, each 16..8192 (e.g. 1280x720)", command,
+                         option, text);
+    return {w, h};
+}
+
+morph::Backend parse_backend(const std::string& text, const std::string& command) {
+    if (text == "auto") return morph::Backend::Auto;
+    if (text == "cpu") return morph::Backend::Cpu;
+    if (text == "cuda") return morph::Backend::Cuda;
+    fail<InputError>("{}: --backend '{}': expected auto, cpu or cuda", command, text);
+}
+
+void check_output_folder(const std::string& path, const std::string& command,
+                         const std::string& option) {
+    if (path.empty()) fail<InputError>("{}: {} is empty", command, option);
+    const auto dir = std::filesystem::path(path).parent_path();
+    if (!dir.empty() && !std::filesystem::is_directory(dir))
+        fail<InputError>("{}: {} {}: folder {} does not exist", command, option, path, dir.string());
+}
+
+expression::Face load_session_face(const SessionOptions& o) {
+    if (o.face.empty() || o.face == "default") {
+        if (!o.fdp.empty()) fail<InputError>("session: --fdp is for an .obj face, not the default face");
+        if (!std::filesystem::is_directory(o.data + "/face"))
+            fail<InputError>("session: data folder {}: no face/ there (point --data at the project's data/)",
+                             o.data);
+        expression::DefaultFaceOptions fo;
+        fo.resolution_scale = o.face_resolution;
+        return expression::make_default_face(o.data + "/face", fo);
+    }
+    if (!std::filesystem::is_regular_file(o.face))
+        fail<InputError>("session: --face {}: no such file (expected default, FILE.wfm or FILE.obj)", o.face);
+    if (ends_with(o.face, ".wfm")) {
+        if (!o.fdp.empty()) fail<InputError>("session: --fdp is for an .obj face, not a Candide-3 .wfm");
+        return expression::load_candide3(o.face);
+    }
+    if (ends_with(o.face, ".obj")) {
+        std::string fdp = o.fdp;
+        if (fdp.empty()) {
+            fdp = o.face.substr(0, o.face.size() - 4) + ".fdp.json";
+            if (!std::filesystem::is_regular_file(fdp))
+                fail<InputError>("session: --face {}: give its feature points with --fdp FILE.json "
+                                 "(looked for {})",
+                                 o.face, fdp);
+        } else if (!std::filesystem::is_regular_file(fdp)) {
+            fail<InputError>("session: --fdp {}: no such file", fdp);
+        }
+        expression::Face face = expression::load_obj_with_fdp(o.face, fdp);
+        if (face.base_colour.empty() && !face.base_colour_file.empty()) {
+            const render::ImageRGBA8 img = render::read_image_rgba8(face.base_colour_file);
+            face.base_colour.width = img.width;
+            face.base_colour.height = img.height;
+            face.base_colour.rgba = img.pixels;
+        }
+        return face;
+    }
+    fail<InputError>("session: --face {}: expected default, a Candide-3 .wfm or an .obj file", o.face);
+}
+
+// --- Session -----------------------------------------------------------------
+
+Session::Session(const SessionOptions& options, render::Platform* window) : options_(options) {
+    if (options_.wrinkle_size < 256 || options_.wrinkle_size > 4096)
+        fail<InputError>("session: wrinkle map size {}: expected 256..4096", options_.wrinkle_size);
+    if (options_.backend == morph::Backend::Cuda && !morph::cuda_available())
+        fail<EnvironmentError>("session: --backend cuda: {} (use --backend cpu or auto)",
+                               morph::cuda_device_description());
+    for (const char* file : {"emotions.json", "visemes.json", "feature_lines.json", "wrinkles.json"})
+        if (!std::filesystem::is_regular_file(options_.data + "/expression/" + file))
+            fail<InputError>("session: data folder {}: expression/{} is missing (point --data at the "
+                             "project's data/)",
+                             options_.data, file);
+
+    auto t = Clock::now();
+    assets_ = std::make_unique<render::FaceAssets>();
+    render::FaceAssets& a = *assets_;
+    a.face = load_session_face(options_);
+    load_.face_ms = ms_since(t);
+
+    t = Clock::now();
+    a.rig = std::make_unique<expression::FaceRig>(a.face);
+    load_.rig_ms = ms_since(t);
+
+    t = Clock::now();
+    const std::string dir = options_.data + "/expression/";
+    a.emotions = expression::load_emotion_profiles(dir + "emotions.json");
+    a.visemes = expression::load_viseme_profiles(dir + "visemes.json");
+    std::bitset<expression::kFeatureCount> present;
+    for (int i = 0; i < expression::kFeatureCount; ++i) present[i] = a.face.feature_points[i].present;
+    a.lines = expression::lines_for_face(expression::load_feature_lines(dir + "feature_lines.json"), present);
+    const expression::WrinkleLibrarySpec spec = expression::load_wrinkle_spec(dir + "wrinkles.json");
+    load_.profiles_ms = ms_since(t);
+
+    // The seven keys, each at its own expression's full intensity (neutral:
+    // no FAPs); independent, so generated side by side.
+    t = Clock::now();
+    std::vector<std::future<render::WrinkleKey>> keys;
+    const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+    a.keys.resize(expression::kWrinkleKeyCount);
+    for (int k = 0; k < expression::kWrinkleKeyCount; ++k) {
+        auto make = [&a, &spec, k, size = options_.wrinkle_size] {
+            expression::FapValues pose{};
+            if (k > 0) pose = a.emotions.profiles[std::size_t(k - 1)];
+            return render::make_wrinkle_key(a.face, *a.rig, spec, expression::WrinkleKey(k), pose, size);
+        };
+        keys.push_back(std::async(threads > 1 ? std::launch::async : std::launch::deferred, make));
+    }
+    for (int k = 0; k < expression::kWrinkleKeyCount; ++k) a.keys[std::size_t(k)] = keys[std::size_t(k)].get();
+    load_.keys_ms = ms_since(t);
+
+    t = Clock::now();
+    if (window) {
+        platform_ = window;
+    } else {
+        render::PlatformOptions po;
+        po.width = options_.width;
+        po.height = options_.height;
+        po.samples = options_.samples;
+        // With CUDA, the EGL device that is the morph's GPU (interop).
+        if (options_.backend != morph::Backend::Cpu) po.cuda_device = 0;
+        owned_platform_ = std::make_unique<render::HeadlessPlatform>(po);
+        platform_ = owned_platform_.get();
+        load_.platform_ms = ms_since(t);
+    }
+    spdlog::debug("session: {}", platform_->description());
+
+    t = Clock::now();
+    make_scene();
+    load_.scene_ms = ms_since(t);
+}
+
+Session::~Session() {
+    scene_.reset();
+    owned_platform_.reset();
+}
+
+void Session::make_scene() {
+    platform_->make_current();
+    scene_.reset();
+    render::FaceSceneOptions so;
+    so.backend = options_.backend;
+    scene_ = render::make_face_scene(*platform_, *assets_, so);
+    // The scene starts neutral.
+    const auto fp = assets_->rig->feature_points(expression::FapValues{});
+    for (int i = 0; i < expression::kFeatureCount; ++i)
+        points_[std::size_t(i)] =
+            assets_->face.feature_points[std::size_t(i)].present
+                ? std::optional<glm::vec3>(glm::vec3(float(fp[i][0]), float(fp[i][1]), float(fp[i][2])))
+                : std::nullopt;
+}
+
+void Session::set_backend(morph::Backend backend) {
+    if (backend == morph::Backend::Cuda && !morph::cuda_available())
+        fail<EnvironmentError>("session: CUDA backend: {} (use the CPU backend)",
+                               morph::cuda_device_description());
+    options_.backend = backend;
+    make_scene();
+}
+
+expression::FaceState Session::face_state(const fap::FapFrame& frame) const {
+    return expression::face_state(frame, assets_->emotions, &assets_->visemes);
+}
+
+expression::FaceState Session::face_state(const expression::EmotionMix& mix) const {
+    return expression::face_state(mix, assets_->emotions);
+}
+
+void Session::update(const expression::FaceState& state) {
+    scene_->update(state.faps, render::key_weights(state.mix));
+    last_.scene = scene_->last_times();
+    const auto fp = assets_->rig->feature_points(state.faps);
+    for (int i = 0; i < expression::kFeatureCount; ++i)
+        if (points_[std::size_t(i)])
+            points_[std::size_t(i)] = glm::vec3(float(fp[i][0]), float(fp[i][1]), float(fp[i][2]));
+}
+
+void Session::draw(const render::DrawOptions& options) {
+    const auto t = Clock::now();
+    scene_->draw(options);
+    last_.draw_ms = ms_since(t);
+}
+
+render::DrawOptions Session::draw_options(float aspect) const {
+    render::DrawOptions d;
+    d.camera = scene_->frontal_camera(aspect);
+    d.light = scene_->portrait_light();
+    d.wrinkles = options_.wrinkles;
+    return d;
+}
+
+render::ImageRGBA8 Session::render_frame(const expression::FaceState& state) {
+    const auto t0 = Clock::now();
+    update(state);
+    platform_->begin_frame();
+    draw(draw_options(float(platform_->width()) / float(platform_->height())));
+    const auto t = Clock::now();
+    platform_->end_frame();
+    render::ImageRGBA8 image = platform_->read_rgba();
+    last_.readback_ms = ms_since(t);
+    last_.total_ms = ms_since(t0);
+    totals_.add(last_);
+    return image;
+}
+
+render::ImageRGBA8 Session::wrinkle_map() const {
+    platform_->make_current();
+    render::WrinkleTexture& tex = scene_->wrinkle_texture();
+    render::ImageRGBA8 out(tex.width(), tex.height());
+    if (tex.format() != render::TexelFormat::RGBA8)
+        fail<Error>("session: the wrinkle texture is not RGBA8");
+    tex.download(out.pixels.data());
+    return out;
+}
+
+std::array<std::optional<glm::vec2>, 84> Session::screen_points(const render::Camera& camera, int width,
+                                                                int height) const {
+    std::array<std::optional<glm::vec2>, 84> out{};
+    const glm::mat4 m = camera.projection * camera.view;
+    for (std::size_t i = 0; i < out.size(); ++i) {
+        if (!points_[i]) continue;
+        const glm::vec4 c = m * glm::vec4(*points_[i], 1.0f);
+        if (!(c.w > 0.0f)) continue;
+        const float x = c.x / c.w, y = c.y / c.w;
+        out[i] = glm::vec2((x * 0.5f + 0.5f) * float(width), (0.5f - y * 0.5f) * float(height));
+    }
+    return out;
+}
+
+std::string Session::description() const {
+    const auto& f = assets_->face;
+    return fmt::format("{} face ({} vertices, {} triangles), {} feature lines, wrinkle maps {}x{}, morph on {}{}",
+                       f.name.empty() ? options_.face : f.name, f.vertex_count(), f.mesh.n_faces(),
+                       assets_->lines.size(), options_.wrinkle_size, options_.wrinkle_size,
+                       morph::to_string(scene_->morpher().backend()),
+                       scene_->uses_interop() ? " (CUDA-GL interop)" : "");
+}
+
+}  // namespace emoface::apps

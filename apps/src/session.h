@@ -1,0 +1,174 @@
+#pragma once
+// What every drawing command (play, mix, inspect, morph) and the viewer share:
+// a face with its rig, profiles, feature lines and seven key wrinkle maps
+// (generated once and kept in memory), a GL platform (headless, or a window
+// the caller made) and the FaceScene that draws one frame of it.
+//
+//   Session s(options);                       // headless, options.width x height
+//   auto state = s.face_state(stream.resolved(k));
+//   render::ImageRGBA8 img = s.render_frame(state);
+//
+// The viewer passes its own WindowPlatform and draws with its own camera:
+//   Session s(options, &window);
+//   s.update(state); window.begin_frame(); s.draw(opts); window.end_frame();
+#include <array>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+#include "emoface/expression/emotion.h"
+#include "emoface/expression/face_state.h"
+#include "emoface/fap/fap_stream.h"
+#include "emoface/morph/morph.h"
+#include "emoface/render/face_assets.h"
+#include "emoface/render/face_scene.h"
+#include "emoface/render/image.h"
+#include "emoface/render/platform.h"
+
+namespace emoface::apps {
+
+struct SessionOptions {
+    // "default" (the generated face of data/face), a Candide-3 FILE.wfm, or
+    // FILE.obj with its feature points in `fdp` (default: FILE.fdp.json
+    // beside it, as `emoface face` writes it).
+    std::string face = "default";
+    std::string fdp;
+    std::string data = EMOFACE_DATA_DIR;  // the project's data/ folder
+    morph::Backend backend = morph::Backend::Auto;
+    int wrinkle_size = 512;  // side of the key and morphed wrinkle maps, 256..4096
+    bool wrinkles = true;    // false: draw with geometric normals only
+    // Headless platform only (a window has its own size).
+    int width = 640;
+    int height = 480;
+    int samples = 4;
+    // Mesh resolution of the default face (1 = face.json's).
+    double face_resolution = 1.0;
+};
+
+// Wall-clock milliseconds of loading, once per session.
+struct LoadTimes {
+    double face_ms = 0;      // build or read the mesh and feature points
+    double rig_ms = 0;       // the rig's influence weights
+    double profiles_ms = 0;  // emotion/viseme profiles, feature lines, wrinkle spec
+    double keys_ms = 0;      // the seven key wrinkle maps
+    double platform_ms = 0;  // GL context (headless only; 0 for a caller's window)
+    double scene_ms = 0;     // FaceScene: meshes, textures, morph setup (allocate + upload)
+    double total() const {
+        return face_ms + rig_ms + profiles_ms + keys_ms + platform_ms + scene_ms;
+    }
+};
+
+// Wall-clock milliseconds of one frame's stages.
+struct FrameTimes {
+    render::FrameStageTimes scene;  // rig, layout, morph, uv, tangents, upload
+    double draw_ms = 0;             // the GL draw (submission)
+    double readback_ms = 0;         // resolve + read RGBA (waits for the GPU)
+    double total_ms = 0;            // the whole render_frame()
+};
+
+// Sums frame times to report means.
+struct FrameTimeTotals {
+    FrameTimes sum;
+    int frames = 0;
+    void add(const FrameTimes& t);
+    FrameTimes mean() const;
+};
+
+// Lines of "stage   mean ms" for a report: loading, then per frame.
+std::string format_times(const LoadTimes& load, const FrameTimeTotals& frames);
+
+// Reads a FAP file for playing; InputError when it has no frames or its
+// frame rate is not positive.
+fap::FapStream load_fap_stream(const std::string& path);
+
+// Parses "WIDTHxHEIGHT" (each 16..8192); InputError starting `command: `.
+std::pair<int, int> parse_size(const std::string& text, const std::string& command,
+                               const std::string& option = "--size");
+// "auto" | "cpu" | "cuda"; InputError otherwise.
+morph::Backend parse_backend(const std::string& text, const std::string& command);
+// Throws InputError when `path`'s folder does not exist (checked before the
+// slow part, so bad input fails fast and writes nothing).
+void check_output_folder(const std::string& path, const std::string& command,
+                         const std::string& option = "--out");
+
+class Session {
+public:
+    // Loads the face and its assets and opens the platform: a headless one
+    // of options.width x height, or `window` (made by the caller, which must
+    // outlive the session). Throws InputError for a bad face or data folder,
+    // EnvironmentError when no GL context (or, for --backend cuda, no GPU)
+    // can be had.
+    explicit Session(const SessionOptions& options, render::Platform* window = nullptr);
+    ~Session();
+    Session(const Session&) = delete;
+    Session& operator=(const Session&) = delete;
+
+    // The state a FAP frame shows (pass a resolved or sampled frame).
+    expression::FaceState face_state(const fap::FapFrame& frame) const;
+    // The state a mix shows: its profiles' FAPs and the mix for the wrinkles.
+    expression::FaceState face_state(const expression::EmotionMix& mix) const;
+
+    // Poses the scene: rig, layout, morph of the keys by the state's mix.
+    void update(const expression::FaceState& state);
+    // Draws into the platform's bound framebuffer (call begin_frame first).
+    void draw(const render::DrawOptions& options);
+    // The frontal camera and portrait light for this aspect ratio, wrinkles
+    // as the options say.
+    render::DrawOptions draw_options(float aspect) const;
+    // update + begin_frame + draw (frontal, whole target) + end_frame + read.
+    render::ImageRGBA8 render_frame(const expression::FaceState& state);
+
+    // The current (morphed) wrinkle map, RGBA8 normal map, rows top first.
+    render::ImageRGBA8 wrinkle_map() const;
+    // The current pose's feature points in face space (absent: nullopt).
+    const std::array<std::optional<glm::vec3>, 84>& feature_points() const { return points_; }
+    // The feature points projected by `camera` to pixel coordinates of a
+    // width x height image (x right, y DOWN from the top row); nullopt for
+    // absent points and those behind the camera.
+    std::array<std::optional<glm::vec2>, 84> screen_points(const render::Camera& camera, int width,
+                                                           int height) const;
+    // The current layout L*: feature points in wrinkle-map coordinates
+    // (normalised, y down).
+    const expression::FeatureLayout& layout() const { return scene_->layout(); }
+    // The morph's feature lines (pairs of feature-point indices).
+    const std::vector<expression::FeatureLine>& lines() const { return assets_->lines; }
+
+    // Rebuilds the scene on another morph backend (keys are reused).
+    void set_backend(morph::Backend backend);
+    morph::Backend backend() const { return scene_->morpher().backend(); }
+    void set_wrinkles(bool on) { options_.wrinkles = on; }
+    bool wrinkles() const { return options_.wrinkles; }
+
+    const SessionOptions& options() const { return options_; }
+    const render::FaceAssets& assets() const { return *assets_; }
+    render::FaceScene& scene() { return *scene_; }
+    render::Platform& platform() { return *platform_; }
+    // "default face (12345 vertices), morph on CPU" and the like.
+    std::string description() const;
+
+    const LoadTimes& load_times() const { return load_; }
+    const FrameTimes& last_frame_times() const { return last_; }
+    const FrameTimeTotals& frame_totals() const { return totals_; }
+
+private:
+    void make_scene();
+
+    SessionOptions options_;
+    std::unique_ptr<render::FaceAssets> assets_;
+    std::unique_ptr<render::Platform> owned_platform_;
+    render::Platform* platform_ = nullptr;
+    std::unique_ptr<render::FaceScene> scene_;
+    std::array<std::optional<glm::vec3>, 84> points_{};
+    LoadTimes load_;
+    FrameTimes last_;
+    FrameTimeTotals totals_;
+};
+
+// Loads the face named by options.face / options.fdp (no rig, no keys).
+expression::Face load_session_face(const SessionOptions& options);
+
+}  // namespace emoface::apps
