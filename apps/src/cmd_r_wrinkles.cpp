@@ -1,0 +1,86 @@
+// emoface wrinkles: writes the seven key wrinkle maps (neutral + six
+// emotions) and the feature layout each was made at, so an artist can replace
+// any map with a painted one plus its layout.
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+
+#include "command.h"
+#include "emoface/common/error.h"
+#include "emoface/expression/feature_layout.h"
+#include "emoface/render/face_assets.h"
+#include "emoface/render/image_io.h"
+#include "session.h"
+
+namespace emoface::apps {
+namespace {
+
+struct WrinklesArgs {
+    std::string out;
+    int size = 1024;
+    std::string face = "default";
+    std::string fdp;
+    std::string data = EMOFACE_DATA_DIR;
+};
+
+render::ImageRGBA8 to_image(const expression::NormalMap& map) {
+    render::ImageRGBA8 image(map.width, map.height);
+    image.pixels = map.rgba;
+    return image;
+}
+
+void run_wrinkles(const WrinklesArgs& args) {
+    if (args.size < 256 || args.size > 4096)
+        fail<InputError>("wrinkles: --size must be 256..4096, found {}", args.size);
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    if (fs::exists(args.out, ec) && !fs::is_directory(args.out, ec))
+        fail<InputError>("wrinkles: --out {}: expected a folder, found a file", args.out);
+    const fs::path parent = fs::absolute(args.out).parent_path();
+    if (!fs::is_directory(parent, ec))
+        fail<InputError>("wrinkles: --out {}: folder {} does not exist", args.out, parent.string());
+
+    const auto start = std::chrono::steady_clock::now();
+    SessionOptions face_options;
+    face_options.face = args.face;
+    face_options.fdp = args.fdp;
+    face_options.data = args.data;
+    render::FaceAssetsOptions asset_options;
+    asset_options.wrinkle_map_size = args.size;
+    const auto assets = render::load_face_assets(load_session_face(face_options), args.data, asset_options);
+
+    fs::create_directories(args.out);
+    for (const render::WrinkleKey& key : assets->keys) {
+        const std::string stem = (fs::path(args.out) / key.name).string();
+        render::write_image(stem + ".png", to_image(key.map));
+        expression::save_layout(key.layout, stem + ".layout.json");
+    }
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::printf("wrinkles: %zu maps of %dx%d and their layouts in %s (%.1f s)\n", assets->keys.size(),
+                args.size, args.size, args.out.c_str(), seconds);
+    for (const render::WrinkleKey& key : assets->keys)
+        std::printf("  %s.png  %s.layout.json\n", key.name.c_str(), key.name.c_str());
+}
+
+void add_wrinkles_command(CLI::App& root) {
+    auto args = std::make_shared<WrinklesArgs>();
+    CLI::App* sub = root.add_subcommand(
+        "wrinkles",
+        "Write the seven key wrinkle maps (neutral + six emotions, tangent-space normal maps, PNG)\n"
+        "and the feature layout of each (JSON). Replace any map with a painted one plus its layout.");
+    sub->add_option("--out", args->out, "Output folder (created if missing; its parent must exist)")
+        ->required();
+    sub->add_option("--size", args->size, "Side of the square maps, 256..4096")->capture_default_str();
+    sub->add_option("--face", args->face, "default, FILE.wfm (Candide-3) or FILE.obj")
+        ->capture_default_str();
+    sub->add_option("--fdp", args->fdp, "Feature points of an OBJ face (default: FILE.fdp.json)");
+    sub->add_option("--data", args->data, "The project's data folder")->capture_default_str();
+    sub->callback([args] { run_wrinkles(*args); });
+}
+
+}  // namespace
+
+EMOFACE_COMMAND(add_wrinkles_command)
+
+}  // namespace emoface::apps
