@@ -356,7 +356,9 @@ Face load_obj_with_fdp(const std::string& obj_path, const std::string& fdp_path)
         if (c.vt == first_uv[c.v] || c.vt < 0) return c.v;
         auto [it, inserted] = copies.emplace(std::pair{c.v, c.vt}, 0);
         if (inserted) {
-            auto vh = face.mesh.add_vertex(face.mesh.point(TriMesh::VertexHandle(c.v)));
+            // A copy: add_vertex may grow the storage the reference would point into.
+            const TriMesh::Point p = face.mesh.point(TriMesh::VertexHandle(c.v));
+            auto vh = face.mesh.add_vertex(p);
             face.mesh.set_texcoord2D(vh, TriMesh::TexCoord2D(static_cast<float>(uvs[c.vt][0]), static_cast<float>(uvs[c.vt][1])));
             it->second = vh.idx();
             face.welded.push_back({c.v, vh.idx()});
