@@ -36,7 +36,14 @@ void add_view_command(CLI::App& root) {
     sub->add_option("--size", args->size, "Window size WIDTHxHEIGHT")->capture_default_str();
     sub->add_option("--backend", args->backend, "Morph backend: auto, cpu or cuda")
         ->capture_default_str();
+    sub->add_option("--wrinkle-size", args->viewer.wrinkle_size,
+                    "Side of the wrinkle maps (256..4096)")
+        ->capture_default_str();
     sub->add_flag("--no-wrinkles", args->no_wrinkles, "Start with the wrinkle map off");
+    sub->add_flag("--points", args->viewer.show_points, "Start with the feature points shown");
+    sub->add_flag("--lines", args->viewer.show_lines, "Start with the morph's feature lines shown");
+    sub->add_flag("--labels", args->viewer.show_labels,
+                  "Start with the feature points shown with their labels (2.1 ... 11.6)");
     sub->add_option("--quit-after", args->viewer.quit_after_frames,
                     "Close after this many frames (0: when the window is closed)")
         ->check(CLI::NonNegativeNumber);

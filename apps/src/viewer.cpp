@@ -13,9 +13,11 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cfloat>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -150,11 +152,13 @@ public:
         driven_by_file_ = stream_.has_value() && options.mix.empty();
         playing_ = driven_by_file_;
         wrinkles_ = options.wrinkles;
+        show_points_ = options.show_points || options.show_labels;
+        show_lines_ = options.show_lines;
+        show_labels_ = options.show_labels;
         backend_choice_ = int(options.backend);
         cuda_ok_ = morph::cuda_available();
         reset_view();
         std::snprintf(mix_text_, sizeof mix_text_, "%s", mix.to_string().c_str());
-        glfwSetWindowTitle(window_.window(), title().c_str());
     }
 
     // Runs until the window closes or quit_after_frames frames were shown.
@@ -170,6 +174,9 @@ public:
 
             if (playing_ && stream_) advance(dt);
             render_frame();
+            // The title says "loading" until the face and the panel are on
+            // screen (ImGui shows a new window from its second frame on).
+            if (frames == 2) glfwSetWindowTitle(window_.window(), title().c_str());
             ++frames;
             if (options_.quit_after_frames > 0 && frames >= options_.quit_after_frames) break;
         }
@@ -331,7 +338,9 @@ private:
 
     void draw_panel() {
         ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
-        ImGui::SetNextWindowSize(ImVec2(330, 0), ImGuiCond_FirstUseEver);
+        ImGui::SetNextWindowSize(ImVec2(360, 0), ImGuiCond_FirstUseEver);
+        // A small window starts with the panel folded, so the face shows.
+        ImGui::SetNextWindowCollapsed(window_.width() < 800, ImGuiCond_FirstUseEver);
         ImGui::SetNextWindowBgAlpha(0.82f);
         ImGui::Begin("emoface");
         frame_time_section();
@@ -342,7 +351,8 @@ private:
         if (ImGui::CollapsingHeader("Wrinkle map")) wrinkle_map_section();
         ImGui::Separator();
         ImGui::TextDisabled("left-drag orbit, wheel zoom, middle-drag pan,\n"
-                            "right-drag light, R reset view, space play/pause");
+                            "right-drag light, R reset view, space play/pause,\n"
+                            "Esc quit");
         ImGui::End();
     }
 
@@ -350,13 +360,12 @@ private:
         const double ms = frame_seconds_ * 1000.0;
         ImGui::Text("frame %.1f ms (%.0f frames/s)", ms, ms > 0 ? 1000.0 / ms : 0.0);
         const auto& s = session_.scene().last_times();
-        ImGui::Text("update %.1f ms: rig %.1f, layout %.1f, morph %.1f,\n"
-                    "  uv %.1f, tangents %.1f, upload %.1f; draw %.1f",
-                    update_ms_, s.rig_ms, s.layout_ms, s.morph_ms, s.uv_ms, s.tangents_ms,
-                    s.upload_ms, draw_ms_);
+        ImGui::Text("update %.1f ms, draw %.1f ms (submission)", update_ms_, draw_ms_);
+        ImGui::TextDisabled("rig %.1f  layout %.1f  morph %.1f  uv %.1f\ntangents %.1f  upload %.1f",
+                            s.rig_ms, s.layout_ms, s.morph_ms, s.uv_ms, s.tangents_ms, s.upload_ms);
         ImGui::PlotLines("##frame ms", history_.data(), int(history_.size()),
-                         int(history_at_ % history_.size()), "frame ms", 0.0f, 100.0f,
-                         ImVec2(-1, 36));
+                         int(history_at_ % history_.size()), "frame ms", 0.0f, FLT_MAX,
+                         ImVec2(-1, 32));
     }
 
     void timeline_section() {
@@ -537,12 +546,19 @@ int run_viewer(const ViewerOptions& options) {
     if (options.width < 64 || options.height < 64 || options.width > 8192 || options.height > 8192)
         fail<InputError>("view: window size {}x{}: expected 64..8192 on each side", options.width,
                          options.height);
+    if (options.wrinkle_size < 256 || options.wrinkle_size > 4096)
+        fail<InputError>("view: --wrinkle-size {}: expected 256..4096", options.wrinkle_size);
     if (options.quit_after_frames < 0)
         fail<InputError>("view: --quit-after {}: expected a frame count >= 0", options.quit_after_frames);
     std::optional<fap::FapStream> stream;
     if (!options.fap_path.empty()) stream = fap::resolve_untransmitted(load_fap_stream(options.fap_path));
     const expression::EmotionMix mix =
         options.mix.empty() ? expression::EmotionMix{} : expression::parse_emotion_mix(options.mix);
+    if (options.face != "default" && !std::filesystem::is_regular_file(options.face))
+        fail<InputError>("view: --face {}: no such file (expected default, FILE.wfm or FILE.obj)",
+                         options.face);
+    if (!options.fdp.empty() && !std::filesystem::is_regular_file(options.fdp))
+        fail<InputError>("view: --fdp {}: no such file", options.fdp);
     if (!options.screenshot.empty()) check_output_folder(options.screenshot, "view", "--screenshot");
     if (options.backend == morph::Backend::Cuda && !morph::cuda_available())
         fail<EnvironmentError>("view: --backend cuda: {} (use --backend cpu or auto)",
@@ -557,6 +573,7 @@ int run_viewer(const ViewerOptions& options) {
     so.fdp = options.fdp;
     so.backend = options.backend;
     so.wrinkles = options.wrinkles;
+    so.wrinkle_size = options.wrinkle_size;
     Session session(so, window.get());
     spdlog::debug("view: {} on {}", session.description(), window->description());
 

@@ -21,6 +21,9 @@ struct ViewerOptions {
     bool wrinkles = true;
     int quit_after_frames = 0;  // > 0: render this many frames, then close
     std::string screenshot;     // non-empty: the last frame is written here (PNG, ...)
+    int wrinkle_size = 512;     // side of the key and morphed wrinkle maps, 256..4096
+    // The overlay's toggles as the viewer starts.
+    bool show_points = false, show_lines = false, show_labels = false;
 };
 
 // Runs the viewer until the window is closed (or quit_after_frames frames).

@@ -1,0 +1,49 @@
+#pragma once
+// What the viewer test needs from X: a private Xvfb server, finding the
+// viewer's window by its title, reading the window's pixels as the server
+// holds them (what a person sees), and asking it to close as a window
+// manager would. In its own file because Xlib's macros (None, Bool, Status)
+// break C++ headers.
+#include <sys/types.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace emoface::apps::testing {
+
+// An Xvfb server on a display number it picks itself (-displayfd), so tests
+// running side by side never collide. Stopped by the destructor.
+class VirtualDisplay {
+public:
+    // Empty name() when Xvfb cannot be found or started; why() says which.
+    VirtualDisplay(int width, int height);
+    ~VirtualDisplay();
+    VirtualDisplay(const VirtualDisplay&) = delete;
+    VirtualDisplay& operator=(const VirtualDisplay&) = delete;
+
+    const std::string& name() const { return name_; }  // ":93"
+    const std::string& why() const { return why_; }
+
+private:
+    pid_t pid_ = -1;
+    std::string name_, why_;
+};
+
+struct WindowShot {
+    int width = 0, height = 0;
+    std::vector<std::uint8_t> rgb;  // top row first
+    std::string title;
+};
+
+// Waits up to `seconds` for a top-level window whose title starts with
+// `title_prefix` and does not contain `not_containing` (when given), then
+// reads its pixels. False on time-out or when the pixels cannot be read.
+bool grab_window(const std::string& display, const std::string& title_prefix,
+                 const std::string& not_containing, double seconds, WindowShot& shot);
+
+// Sends WM_DELETE_WINDOW to the first window titled `title_prefix`... (the
+// close button of a window manager). False when there is no such window.
+bool request_close(const std::string& display, const std::string& title_prefix);
+
+}  // namespace emoface::apps::testing
