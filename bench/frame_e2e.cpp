@@ -102,7 +102,7 @@ void fence() {
 int main(int argc, char** argv) {
     CLI::App app{"emoface end-to-end frame benchmark (FAP sample to fenced draw)"};
     std::string data_dir = EMOFACE_DATA_DIR, fap_path, save, compare, backend_name = "auto";
-    std::string frames_name = "mesh";
+    std::string frames_name = "mesh", accuracy = "exact";
     int frames = 500, warmup = 30, map_size = 2048, width = 1920, height = 1080, samples = 4;
     int check_frame = 25;
     double face_scale = 1.0, min_psnr = 30.0;
@@ -119,6 +119,8 @@ int main(int argc, char** argv) {
     app.add_option("--tangents", frames_name,
                    "wrinkle UVs and tangent frames: mesh (CPU, uploaded) or shader (closed form)")
         ->check(CLI::IsMember({"mesh", "shader"}));
+    app.add_option("--accuracy", accuracy, "morph accuracy: exact or fast")
+        ->check(CLI::IsMember({"exact", "fast"}));
     app.add_option("--check-frame", check_frame, "stream frame saved or compared");
     app.add_option("--save", save, "write the check frame as PPM (the reference, on the CPU)");
     app.add_option("--compare", compare, "PPM reference to compare the check frame with");
@@ -150,14 +152,15 @@ int main(int argc, char** argv) {
         render::FaceSceneOptions so;
         so.backend = backend;
         so.frames = frames_name == "shader" ? render::WrinkleFrames::Shader : render::WrinkleFrames::Mesh;
+        so.morph.accuracy = accuracy == "fast" ? morph::Accuracy::Fast : morph::Accuracy::Exact;
         t = Clock::now();
         render::FaceScene scene(platform, face, *assets->rig, assets->keys, assets->lines, so);
         const double scene_ms = ms(Clock::now() - t);
         const morph::SetupTimes setup = scene.morpher().setup_times();
 
         std::printf("frame_e2e: %s\n", platform.description().c_str());
-        std::printf("  morph: %s backend, %s; %d keys %dx%d, %zu lines; interop %s\n",
-                    morph::to_string(scene.morpher().backend()),
+        std::printf("  morph: %s backend (%s), %s; %d keys %dx%d, %zu lines; interop %s\n",
+                    morph::to_string(scene.morpher().backend()), accuracy.c_str(),
                     morph::cuda_device_description().c_str(), scene.key_count(), map_size,
                     map_size, assets->lines.size(), scene.uses_interop() ? "yes" : "no");
         std::printf("  wrinkle UVs and tangent frames: %s\n",

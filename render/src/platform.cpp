@@ -112,7 +112,9 @@ void Platform::end_frame() {
     glBlitFramebuffer(0, 0, width_, height_, 0, 0, width_, height_, GL_COLOR_BUFFER_BIT,
                       GL_NEAREST);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    check_gl("resolving the multisampled frame");
+    // The one error check of a frame (the renderer's per-frame calls skip
+    // theirs): whatever failed since the last check is reported here.
+    check_gl("drawing or resolving the frame");
 }
 
 void Platform::read_rgba(ImageRGBA8& out) const {
