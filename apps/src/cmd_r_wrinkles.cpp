@@ -9,7 +9,7 @@
 #include "emoface/common/error.h"
 #include "emoface/expression/feature_layout.h"
 #include "emoface/render/face_assets.h"
-#include "emoface/render/image_io.h"
+#include "emoface/render/wrinkle_keys_io.h"
 #include "session.h"
 
 namespace emoface::apps {
@@ -22,12 +22,6 @@ struct WrinklesArgs {
     std::string fdp;
     std::string data = EMOFACE_DATA_DIR;
 };
-
-render::ImageRGBA8 to_image(const expression::NormalMap& map) {
-    render::ImageRGBA8 image(map.width, map.height);
-    image.pixels = map.rgba;
-    return image;
-}
 
 void run_wrinkles(const WrinklesArgs& args) {
     if (args.size < 256 || args.size > 4096)
@@ -50,11 +44,7 @@ void run_wrinkles(const WrinklesArgs& args) {
     const auto assets = render::load_face_assets(load_session_face(face_options), args.data, asset_options);
 
     fs::create_directories(args.out);
-    for (const render::WrinkleKey& key : assets->keys) {
-        const std::string stem = (fs::path(args.out) / key.name).string();
-        render::write_image(stem + ".png", to_image(key.map));
-        expression::save_layout(key.layout, stem + ".layout.json");
-    }
+    render::write_wrinkle_keys(args.out, assets->keys);
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::printf("wrinkles: %zu maps of %dx%d and their layouts in %s (%.1f s)\n", assets->keys.size(),
