@@ -191,17 +191,21 @@ void grid_rows_t(const CpuJob& job, int g0, int g1) {
 }
 
 // Fast mode, pass 2, for cell rows [t0, t1): per cell, its near lines;
-// the far sums at its corners; per pixel row, the far sums interpolated
-// along the row plus the near lines' exact terms (kernel.h, "fast mode").
-template <int K, Law L, int C>
+// the far sums at its corners; per run of R pixels of a cell row, the far
+// sums interpolated along the row plus the near lines' exact terms
+// (kernel.h, "fast mode"). R = 8 (4 for 4-pixel cells) keeps the number of
+// instantiations, and the build time, down.
+template <int K, Law L, int R>
 void fast_tiles_t(const CpuJob& job, int t0, int t1) {
     const FramePlan& plan = *job.plan;
     constexpr int S = kernel::sum_floats(K);
+    const int C = plan.fast_cell;
+    const float inv_c = 1.0f / static_cast<float>(C);
     const float inv = plan.inv_extent;
     const float reach = (plan.fast_reach + 0.70711f) * static_cast<float>(C) * inv;
     const int tiles_w = (job.width + C - 1) / C;
     unsigned short list[kernel::kMaxNear];
-    Accum<K, C> acc;
+    Accum<K, R> acc;
     for (int ty = t0; ty < t1; ++ty) {
         for (int tx = 0; tx < tiles_w; ++tx) {
             const float cx = (static_cast<float>(tx * C) + 0.5f + 0.5f * C) * inv;
@@ -218,41 +222,47 @@ void fast_tiles_t(const CpuJob& job, int t0, int t1) {
                                            (static_cast<float>(gy * C) + 0.5f) * inv, plan.b, corner[c]);
                 }
             }
-            const int x0 = tx * C;
             for (int r = 0; r < C; ++r) {
                 const int y = ty * C + r;
                 if (y >= job.height) break;
-                const float x_iso = (static_cast<float>(x0) + 0.5f) * inv;
                 const float y_iso = (static_cast<float>(y) + 0.5f) * inv;
-                if (exact) {
-                    acc.clear();
-                    for (int l = 0; l < plan.lines; ++l)
-                        kernel::accumulate_line<K, C, L>(plan.records + static_cast<std::size_t>(l) * plan.record_floats,
-                                                         x_iso, y_iso, inv, plan.b, acc);
-                } else {
-                    const float fy = static_cast<float>(r) / C;
-                    float left[S], right[S];
+                const float fy = static_cast<float>(r) * inv_c;
+                float left[S], right[S];
+                if (!exact) {
                     for (int q = 0; q < S; ++q) {
                         left[q] = corner[0][q] + fy * (corner[2][q] - corner[0][q]);
                         right[q] = corner[1][q] + fy * (corner[3][q] - corner[1][q]);
                     }
-                    for (int j = 0; j < C; ++j) {
-                        const float fx = static_cast<float>(j) / C;
-                        acc.w[j] = left[0] + fx * (right[0] - left[0]);
-                        for (int k = 0; k < K; ++k) {
-                            acc.dx[k][j] = left[1 + 2 * k] + fx * (right[1 + 2 * k] - left[1 + 2 * k]);
-                            acc.dy[k][j] = left[2 + 2 * k] + fx * (right[2 + 2 * k] - left[2 + 2 * k]);
-                        }
-                    }
-                    for (int n = 0; n < count; ++n)
-                        kernel::accumulate_line<K, C, L>(plan.records + list[n] * plan.record_floats, x_iso, y_iso,
-                                                         inv, plan.b, acc);
                 }
-                const int run = job.width - x0 < C ? job.width - x0 : C;
-                for (int j = 0; j < run; ++j) {
-                    float dx[K], dy[K];
-                    kernel::displacement(acc, j, plan.extent, dx, dy);
-                    finish_point<K>(job, x0 + j, y, dx, dy);
+                for (int i0 = 0; i0 < C; i0 += R) {
+                    const int x0 = tx * C + i0;
+                    if (x0 >= job.width) break;
+                    const float x_iso = (static_cast<float>(x0) + 0.5f) * inv;
+                    if (exact) {
+                        acc.clear();
+                        for (int l = 0; l < plan.lines; ++l)
+                            kernel::accumulate_line<K, R, L>(
+                                plan.records + static_cast<std::size_t>(l) * plan.record_floats, x_iso, y_iso, inv,
+                                plan.b, acc);
+                    } else {
+                        for (int j = 0; j < R; ++j) {
+                            const float fx = static_cast<float>(i0 + j) * inv_c;
+                            acc.w[j] = left[0] + fx * (right[0] - left[0]);
+                            for (int k = 0; k < K; ++k) {
+                                acc.dx[k][j] = left[1 + 2 * k] + fx * (right[1 + 2 * k] - left[1 + 2 * k]);
+                                acc.dy[k][j] = left[2 + 2 * k] + fx * (right[2 + 2 * k] - left[2 + 2 * k]);
+                            }
+                        }
+                        for (int n = 0; n < count; ++n)
+                            kernel::accumulate_line<K, R, L>(plan.records + list[n] * plan.record_floats, x_iso,
+                                                             y_iso, inv, plan.b, acc);
+                    }
+                    const int run = job.width - x0 < R ? job.width - x0 : R;
+                    for (int j = 0; j < run; ++j) {
+                        float dx[K], dy[K];
+                        kernel::displacement(acc, j, plan.extent, dx, dy);
+                        finish_point<K>(job, x0 + j, y, dx, dy);
+                    }
                 }
             }
         }
@@ -261,38 +271,35 @@ void fast_tiles_t(const CpuJob& job, int t0, int t1) {
 
 template <int K, Law L>
 void apply_rows_t(const CpuJob& job, int t0, int t1) {
-    switch (job.plan->fast_cell) {
-        case 4: fast_tiles_t<K, L, 4>(job, t0, t1); break;
-        case 8: fast_tiles_t<K, L, 8>(job, t0, t1); break;
-        case 16: fast_tiles_t<K, L, 16>(job, t0, t1); break;
-        default: fast_tiles_t<K, L, 32>(job, t0, t1); break;
-    }
+    if (job.plan->fast_cell == 4)
+        fast_tiles_t<K, L, 4>(job, t0, t1);
+    else
+        fast_tiles_t<K, L, 8>(job, t0, t1);
 }
 
-// Run-time source count and weight law -> template.
-#define EMOFACE_CPU_DISPATCH_KL(fn, plan, ...)                                           \
-    do {                                                                                 \
-        const bool sq = (plan).law == Law::InverseSquare;                                \
-        switch ((plan).sources) {                                                        \
-            case 1: sq ? fn<1, Law::InverseSquare>(__VA_ARGS__) : fn<1, Law::Power>(__VA_ARGS__); break; \
-            case 2: sq ? fn<2, Law::InverseSquare>(__VA_ARGS__) : fn<2, Law::Power>(__VA_ARGS__); break; \
-            case 3: sq ? fn<3, Law::InverseSquare>(__VA_ARGS__) : fn<3, Law::Power>(__VA_ARGS__); break; \
-            case 4: sq ? fn<4, Law::InverseSquare>(__VA_ARGS__) : fn<4, Law::Power>(__VA_ARGS__); break; \
-            case 5: sq ? fn<5, Law::InverseSquare>(__VA_ARGS__) : fn<5, Law::Power>(__VA_ARGS__); break; \
-            case 6: sq ? fn<6, Law::InverseSquare>(__VA_ARGS__) : fn<6, Law::Power>(__VA_ARGS__); break; \
-            case 7: sq ? fn<7, Law::InverseSquare>(__VA_ARGS__) : fn<7, Law::Power>(__VA_ARGS__); break; \
-            default: sq ? fn<8, Law::InverseSquare>(__VA_ARGS__) : fn<8, Law::Power>(__VA_ARGS__); break; \
-        }                                                                                \
+// Run-time source count -> template (the weight law is chosen per line).
+#define EMOFACE_CPU_DISPATCH_K(fn, plan, ...)                        \
+    do {                                                             \
+        switch ((plan).sources) {                                    \
+            case 1: fn<1, Law::Runtime>(__VA_ARGS__); break;         \
+            case 2: fn<2, Law::Runtime>(__VA_ARGS__); break;         \
+            case 3: fn<3, Law::Runtime>(__VA_ARGS__); break;         \
+            case 4: fn<4, Law::Runtime>(__VA_ARGS__); break;         \
+            case 5: fn<5, Law::Runtime>(__VA_ARGS__); break;         \
+            case 6: fn<6, Law::Runtime>(__VA_ARGS__); break;         \
+            case 7: fn<7, Law::Runtime>(__VA_ARGS__); break;         \
+            default: fn<8, Law::Runtime>(__VA_ARGS__); break;        \
+        }                                                            \
     } while (0)
 
 inline void exact_rows(const CpuJob& job, int y0, int y1) {
-    EMOFACE_CPU_DISPATCH_KL(exact_rows_t, *job.plan, job, y0, y1);
+    EMOFACE_CPU_DISPATCH_K(exact_rows_t, *job.plan, job, y0, y1);
 }
 inline void grid_rows(const CpuJob& job, int g0, int g1) {
-    EMOFACE_CPU_DISPATCH_KL(grid_rows_t, *job.plan, job, g0, g1);
+    EMOFACE_CPU_DISPATCH_K(grid_rows_t, *job.plan, job, g0, g1);
 }
 inline void apply_rows(const CpuJob& job, int t0, int t1) {
-    EMOFACE_CPU_DISPATCH_KL(apply_rows_t, *job.plan, job, t0, t1);
+    EMOFACE_CPU_DISPATCH_K(apply_rows_t, *job.plan, job, t0, t1);
 }
 
 const CpuKernels& kernels() {

@@ -230,6 +230,9 @@ Morpher::Morpher(int width, int height, PixelFormat format, std::vector<KeyMap> 
     if (keys.empty() || keys.size() > static_cast<std::size_t>(kMaxKeys))
         fail<InputError>("morph: Morpher(): K = {} key maps, expected 1 to {}", keys.size(), kMaxKeys);
 
+    if (keys[0].layout.size() > static_cast<std::size_t>(kMaxLines))
+        fail<InputError>("morph: Morpher(): key 0 layout has {} lines, expected at most {}", keys[0].layout.size(),
+                         kMaxLines);
     Impl& m = *impl_;
     m.width = width;
     m.height = height;

@@ -2,7 +2,7 @@
 // The Beier-Neely warp-and-blend kernel body, written once for both backends
 // (DESIGN.md "CPU and GPU"): the CPU backend calls these functions from its
 // thread pool over runs of 64 pixels, the CUDA backend from one thread per
-// 1 or 4 pixels. Nothing here allocates, throws or touches a backend API.
+// 1, 2, 4 or 8 pixels. Nothing here allocates, throws or touches a backend API.
 //
 // Geometry (DESIGN.md "Beier-Neely warp", thesis 3.2.2 c). Positions are in
 // "iso" units: pixel coordinates divided by S = max(W, H), so distances mean the
@@ -40,7 +40,7 @@
 
 // EMOFACE_UNROLL: loops over sources (at most kMaxKeys) and other short
 // compile-time loops, unrolled on both sides. EMOFACE_PIXEL_LOOP: the loop over
-// a run of points, unrolled into registers on the GPU (1 or 4 points) and
+// a run of points, unrolled into registers on the GPU (1 to 8 points) and
 // vectorised on the CPU (64 points; the accumulators are a local that nothing
 // else can alias).
 #if defined(__CUDACC__)
@@ -74,7 +74,9 @@ EMOFACE_HD constexpr int record_floats(int sources) {
 }
 
 // b = 2 (the default) needs one reciprocal; any other b goes through exp2/log2.
-enum class Law : int { InverseSquare, Power };
+// Runtime picks one of the two per line (per run of points): the CPU uses it,
+// so its row loops are compiled once instead of once per law.
+enum class Law : int { InverseSquare, Power, Runtime };
 
 struct Rgba {
     float r, g, b, a;
@@ -187,8 +189,17 @@ EMOFACE_HD EMOFACE_MORPH_INLINE void accumulate_line(const float* rec, float x0,
     }
     EMOFACE_PIXEL_LOOP
     for (int j = 0; j < PX; ++j) w[j] = fast_sqrt(w[j]) * wk + wa;
-    EMOFACE_PIXEL_LOOP
-    for (int j = 0; j < PX; ++j) w[j] = line_weight<L>(w[j], b);
+    if constexpr (L == Law::Runtime) {
+        if (b == 2.0f) {
+            EMOFACE_PIXEL_LOOP
+            for (int j = 0; j < PX; ++j) w[j] = line_weight<Law::InverseSquare>(w[j], b);
+        } else {
+            for (int j = 0; j < PX; ++j) w[j] = line_weight<Law::Power>(w[j], b);
+        }
+    } else {
+        EMOFACE_PIXEL_LOOP
+        for (int j = 0; j < PX; ++j) w[j] = line_weight<L>(w[j], b);
+    }
     EMOFACE_PIXEL_LOOP
     for (int j = 0; j < PX; ++j) {
         acc.w[j] += w[j];

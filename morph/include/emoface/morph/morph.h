@@ -88,10 +88,11 @@ class Morpher {
 public:
     static constexpr int kMaxKeys = 8;
     static constexpr int kMaxSide = 16384;
+    static constexpr int kMaxLines = 4096;
 
     // Throws emoface::InputError for bad keys (count 0 or over kMaxKeys, null
-    // pixels, sizes that differ, layouts with different line counts, a line of
-    // zero length or with a non-finite coordinate) and emoface::EnvironmentError
+    // pixels, sizes that differ, layouts with different line counts or over
+    // kMaxLines lines, a line of zero length or with a non-finite coordinate) and emoface::EnvironmentError
     // for Backend::Cuda where no device is usable. Backend::Auto picks CUDA when
     // a device is usable, otherwise the CPU with a one-line notice on stderr.
     Morpher(int width, int height, PixelFormat format, std::vector<KeyMap> keys,
