@@ -8,6 +8,7 @@
 #include <future>
 #include <thread>
 
+#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <glm/mat4x4.hpp>
 #include <glm/vec4.hpp>
@@ -121,6 +122,38 @@ void check_output_folder(const std::string& path, const std::string& command,
         fail<InputError>("{}: {} {}: folder {} does not exist", command, option, path, dir.string());
 }
 
+SessionOptions SessionArgs::resolve(const std::string& command, int width, int height) const {
+    SessionOptions o = options;
+    o.backend = parse_backend(backend, command);
+    o.wrinkles = !no_wrinkles;
+    o.width = width;
+    o.height = height;
+    if (o.wrinkle_size < 256 || o.wrinkle_size > 4096)
+        fail<InputError>("{}: --wrinkle-size {}: expected 256..4096", command, o.wrinkle_size);
+    if (!(o.face_resolution >= 0.1 && o.face_resolution <= 2.0))
+        fail<InputError>("{}: --face-resolution {}: expected 0.1..2", command, o.face_resolution);
+    if (o.texture_size != 0 && (o.texture_size < 64 || o.texture_size > 8192))
+        fail<InputError>("{}: --texture-size {}: expected 64..8192 (0: face.json's)", command, o.texture_size);
+    return o;
+}
+
+void add_session_options(CLI::App& sub, SessionArgs& a) {
+    SessionOptions& o = a.options;
+    sub.add_option("--face", o.face, "default, a Candide-3 FILE.wfm, or FILE.obj (with --fdp)")
+        ->capture_default_str();
+    sub.add_option("--fdp", o.fdp, "Feature points of an .obj face (default: FILE.fdp.json beside it)");
+    sub.add_option("--backend", a.backend, "Morph backend: auto, cpu or cuda")->capture_default_str();
+    sub.add_option("--wrinkle-size", o.wrinkle_size, "Side of the wrinkle maps (256..4096)")->capture_default_str();
+    sub.add_option("--samples", o.samples, "Multisampling samples")->check(CLI::Range(1, 16))->capture_default_str();
+    sub.add_flag("--no-wrinkles", a.no_wrinkles, "Draw without the wrinkle maps");
+    sub.add_option("--face-resolution", o.face_resolution,
+                   "Mesh resolution of the default face (0.1..2; smaller loads and draws faster)")
+        ->capture_default_str();
+    sub.add_option("--texture-size", o.texture_size, "Base-colour image side of the default face (0: face.json's)")
+        ->capture_default_str();
+    sub.add_option("--data", o.data, "The project's data folder")->capture_default_str();
+}
+
 expression::Face load_session_face(const SessionOptions& o) {
     if (o.face.empty() || o.face == "default") {
         if (!o.fdp.empty()) fail<InputError>("session: --fdp is for an .obj face, not the default face");
@@ -129,6 +162,7 @@ expression::Face load_session_face(const SessionOptions& o) {
                              o.data);
         expression::DefaultFaceOptions fo;
         fo.resolution_scale = o.face_resolution;
+        fo.texture_size = o.texture_size;
         return expression::make_default_face(o.data + "/face", fo);
     }
     if (!std::filesystem::is_regular_file(o.face))

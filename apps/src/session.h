@@ -29,6 +29,10 @@
 #include "emoface/render/image.h"
 #include "emoface/render/platform.h"
 
+namespace CLI {
+class App;
+}
+
 namespace emoface::apps {
 
 struct SessionOptions {
@@ -45,9 +49,24 @@ struct SessionOptions {
     int width = 640;
     int height = 480;
     int samples = 4;
-    // Mesh resolution of the default face (1 = face.json's).
+    // The default face's mesh resolution (1 = face.json's) and base-colour
+    // size (0 = face.json's): smaller loads faster (tests, quick looks).
     double face_resolution = 1.0;
+    int texture_size = 0;
 };
+
+// The options every drawing command shares, as they come from the command
+// line: --face, --fdp, --backend, --wrinkle-size, --samples, --no-wrinkles,
+// --face-resolution, --texture-size, --data.
+struct SessionArgs {
+    SessionOptions options;
+    std::string backend = "auto";
+    bool no_wrinkles = false;
+    // Checks and resolves them (InputError starting `command: `); width and
+    // height are the headless platform's.
+    SessionOptions resolve(const std::string& command, int width, int height) const;
+};
+void add_session_options(CLI::App& command, SessionArgs& args);
 
 // Wall-clock milliseconds of loading, once per session.
 struct LoadTimes {

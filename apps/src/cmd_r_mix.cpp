@@ -1,0 +1,103 @@
+// emoface mix: the face showing an emotion mixture, as one still or as a
+// contact sheet of the mix at intensities 0, 0.25, 0.5, 0.75 and 1.
+//   emoface mix "0.7 anger + 0.3 fear" --out face.png
+//   emoface mix surprise --sheet --out surprise_sheet.png
+#include <cstdlib>
+#include <memory>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "command.h"
+#include "emoface/common/error.h"
+#include "emoface/expression/emotion.h"
+#include "emoface/render/image_io.h"
+#include "session.h"
+#include "sheet.h"
+#include "viewer.h"
+
+namespace {
+
+using namespace emoface;
+using namespace emoface::apps;
+
+struct MixArgs {
+    std::string mix, out, size;
+    bool sheet = false, normalise = false;
+    SessionArgs session;
+};
+
+constexpr double kSheetIntensities[] = {0.0, 0.25, 0.5, 0.75, 1.0};
+
+expression::EmotionMix scaled(const expression::EmotionMix& mix, double s) {
+    expression::EmotionMix m;
+    for (std::size_t e = 0; e < m.weights.size(); ++e) m.weights[e] = mix.weights[e] * s;
+    return m;
+}
+
+void run_mix(const MixArgs& a) {
+    const expression::EmotionMix mix = expression::parse_emotion_mix(a.mix, a.normalise);
+    if (a.out.empty()) {
+        const char* display = std::getenv("DISPLAY");
+        if (!display || !*display)
+            fail<EnvironmentError>("mix: no display for the viewer (DISPLAY is not set): give --out "
+                                   "face.png to write a picture");
+#ifdef EMOFACE_HAVE_VIEWER
+        ViewerOptions v;
+        if (!a.size.empty()) std::tie(v.width, v.height) = parse_size(a.size, "mix");
+        const SessionOptions so = a.session.resolve("mix", v.width, v.height);
+        v.face = so.face;
+        v.fdp = so.fdp;
+        v.mix = mix.to_string();
+        v.backend = so.backend;
+        v.wrinkles = so.wrinkles;
+        run_viewer(v);
+        return;
+#else
+        fail<EnvironmentError>("mix: this build has no viewer: give --out face.png");
+#endif
+    }
+    const auto [width, height] = parse_size(a.size.empty() ? (a.sheet ? "320x320" : "720x720") : a.size, "mix");
+    const SessionOptions so = a.session.resolve("mix", width, height);
+    check_output_folder(a.out, "mix");
+    Session session(so);
+
+    if (!a.sheet) {
+        render::write_image(a.out, session.render_frame(session.face_state(mix)));
+        fmt::print("mix: wrote {} ({}x{}, {}{})\n", a.out, width, height, mix.to_string(),
+                   so.wrinkles ? "" : ", without wrinkles");
+    } else {
+        SheetRow row;
+        for (double s : kSheetIntensities) {
+            row.tiles.push_back(to_bgr(session.render_frame(session.face_state(scaled(mix, s)))));
+            row.captions.push_back(fmt::format("intensity {:g}", s));
+        }
+        const cv::Mat sheet = contact_sheet(fmt::format("{}  at intensity 0 .. 1", mix.to_string()), {row});
+        write_bgr(a.out, sheet);
+        fmt::print("mix: wrote {} ({}x{}: {} at intensities 0, 0.25, 0.5, 0.75, 1)\n", a.out, sheet.cols,
+                   sheet.rows, mix.to_string());
+    }
+    fmt::print("mix: {}\n{}", session.description(), format_times(session.load_times(), session.frame_totals()));
+}
+
+void add_mix_command(CLI::App& root) {
+    auto* sub = root.add_subcommand(
+        "mix", "Show an emotion mixture, e.g. \"0.7 anger + 0.3 fear\": a still (--out) or a contact "
+               "sheet of intensities 0..1 (--sheet); without --out, in the viewer");
+    auto a = std::make_shared<MixArgs>();
+    sub->add_option("mix", a->mix,
+                    "Emotion mix: \"0.7 anger + 0.3 fear\", \"joy=0.5, surprise=0.2\", \"sadness\" (joy, "
+                    "sadness, anger, fear, disgust, surprise; weights sum to at most 1)")
+        ->required();
+    sub->add_option("-o,--out", a->out, "Output image (.png, .jpg, .exr, ...)");
+    sub->add_flag("--sheet", a->sheet, "A contact sheet of the mix at intensities 0, 0.25, 0.5, 0.75, 1");
+    sub->add_flag("--normalise", a->normalise, "Scale a mix summing over 1 down to 1");
+    sub->add_option("--size", a->size, "Picture (or sheet tile) size WIDTHxHEIGHT (default 720x720; "
+                                       "320x320 a tile with --sheet)");
+    add_session_options(*sub, a->session);
+    sub->callback([a] { run_mix(*a); });
+}
+
+}  // namespace
+
+EMOFACE_COMMAND(add_mix_command)

@@ -1,0 +1,192 @@
+// emoface play: a FAP file on a face, rendered headless into a video or a
+// frame sequence, or shown in the viewer when there is no --out.
+//   emoface play data/fap/demo_tour.fap --out out/demo.mp4 --size 640x480
+//   emoface play anim.fap --out frames/%04d.png --frames 0:50
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "command.h"
+#include "emoface/common/error.h"
+#include "emoface/render/video_writer.h"
+#include "progress.h"
+#include "session.h"
+#include "viewer.h"
+
+namespace {
+
+using namespace emoface;
+using namespace emoface::apps;
+
+struct PlayArgs {
+    std::string fap, out, size = "1280x720", frames;
+    double fps = 0;
+    SessionArgs session;
+};
+
+// The frames [first, end) of a --frames A:B slice of `count` frames. B is
+// exclusive (as in Python), so 0:50 and 50:107 together are 0:107 = all;
+// either side may be left out (":50", "50:").
+std::pair<int, int> parse_slice(const std::string& text, int count) {
+    if (text.empty()) return {0, count};
+    const auto colon = text.find(':');
+    if (colon == std::string::npos || text.find(':', colon + 1) != std::string::npos)
+        fail<InputError>("play: --frames '{}': expected A:B (first frame, end frame exclusive), "
+                         "e.g. 0:50",
+                         text);
+    auto number = [&](const std::string& part, int fallback) {
+        if (part.empty()) return fallback;
+        char* end = nullptr;
+        const long v = std::strtol(part.c_str(), &end, 10);
+        if (*end != '\0' || part.find_first_not_of("0123456789") != std::string::npos)
+            fail<InputError>("play: --frames '{}': '{}' is not a frame number", text, part);
+        return int(std::min<long>(v, 1L << 30));
+    };
+    const int a = number(text.substr(0, colon), 0);
+    const int b = number(text.substr(colon + 1), count);
+    if (a >= b || b > count)
+        fail<InputError>("play: --frames {}: the animation has frames 0..{} (end exclusive: "
+                         "A < B <= {})",
+                         text, count - 1, count);
+    return {a, b};
+}
+
+enum class OutKind { Video, Sequence };
+
+OutKind output_kind(const std::string& out) {
+    const auto dot = out.find_last_of('.');
+    std::string ext = dot == std::string::npos ? "" : out.substr(dot);
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    if (ext == ".mp4" || ext == ".avi") {
+        if (out.find('%') != std::string::npos)
+            fail<InputError>("play: --out {}: a video name has no %d (that is for frame sequences)", out);
+        return OutKind::Video;
+    }
+    if (out.find('%') != std::string::npos) return OutKind::Sequence;
+    fail<InputError>("play: --out {}: expected a video (.mp4, .avi) or a frame pattern such as "
+                     "frames/%04d.png",
+                     out);
+}
+
+// Frame i of the output at output rate `fps` (the stream's own rate: frame
+// i of the file). `resolved`: the stream with the untransmitted-FAP rule
+// applied to every frame, so one frame needs no walk back.
+fap::FapFrame frame_at(const fap::FapStream& resolved, double fps, int i) {
+    if (fps == resolved.fps) return resolved.frames[std::size_t(i)];
+    const double position = double(i) * resolved.fps / fps;
+    const auto k = std::size_t(std::floor(position));
+    if (k + 1 >= resolved.frames.size()) return resolved.frames.back();
+    // Interpolate between frames k and k + 1 as FapStream::sample does.
+    fap::FapStream two;
+    two.fps = resolved.fps;
+    two.frames = {resolved.frames[k], resolved.frames[k + 1]};
+    return two.sample((position - double(k)) / resolved.fps);
+}
+
+void run_viewer_for(const PlayArgs& a) {
+    const char* display = std::getenv("DISPLAY");
+    const char* wayland = std::getenv("WAYLAND_DISPLAY");
+    if ((!display || !*display) && (!wayland || !*wayland))
+        fail<EnvironmentError>("play: no display for the viewer (DISPLAY is not set): give --out "
+                               "out.mp4 to render headless, or run it under a desktop or xvfb-run");
+#ifdef EMOFACE_HAVE_VIEWER
+    const auto [width, height] = parse_size(a.size, "play");
+    const SessionOptions so = a.session.resolve("play", width, height);
+    ViewerOptions v;
+    v.fap_path = a.fap;
+    v.face = so.face;
+    v.fdp = so.fdp;
+    v.backend = so.backend;
+    v.width = width;
+    v.height = height;
+    v.wrinkles = so.wrinkles;
+    run_viewer(v);
+#else
+    fail<EnvironmentError>("play: this build has no viewer: give --out out.mp4 to render headless");
+#endif
+}
+
+void run_play(const PlayArgs& a) {
+    // Bad input fails before anything slow happens or is written.
+    const fap::FapStream stream = load_fap_stream(a.fap);
+    if (a.fps < 0 || a.fps > 1000) fail<InputError>("play: --fps {}: expected 0 < N <= 1000", a.fps);
+    if (a.out.empty()) {
+        run_viewer_for(a);
+        return;
+    }
+    const auto [width, height] = parse_size(a.size, "play");
+    const SessionOptions so = a.session.resolve("play", width, height);
+    const OutKind kind = output_kind(a.out);
+    check_output_folder(a.out, "play");
+    if (kind == OutKind::Video && (width % 2 || height % 2))
+        fail<InputError>("play: --size {}: a video needs an even width and height", a.size);
+
+    const double fps = a.fps > 0 ? a.fps : stream.fps;
+    const int count = a.fps > 0
+                          ? std::max(1, int(std::lround(double(stream.frames.size()) * fps / stream.fps)))
+                          : int(stream.frames.size());
+    const auto [first, end] = parse_slice(a.frames, count);
+    const fap::FapStream resolved = fap::resolve_untransmitted(stream);
+
+    Session session(so);
+
+    std::unique_ptr<render::VideoWriter> video;
+    std::unique_ptr<render::FrameSequenceWriter> sequence;
+    if (kind == OutKind::Video)
+        video = std::make_unique<render::VideoWriter>(a.out, width, height, fps);
+    else
+        sequence = std::make_unique<render::FrameSequenceWriter>(a.out, first);
+
+    ProgressBar progress("play", end - first);
+    for (int i = first; i < end; ++i) {
+        const expression::FaceState state = session.face_state(frame_at(resolved, fps, i));
+        const render::ImageRGBA8 image = session.render_frame(state);
+        if (video) video->write(image);
+        else sequence->write(image);
+        progress.update(i - first + 1);
+    }
+    progress.finish();
+
+    const std::string slice =
+        (first == 0 && end == count) ? "" : fmt::format(" (frames {}..{} of {})", first, end - 1, count);
+    if (video) {
+        const std::string codec = video->codec();
+        const std::string path = video->close();
+        fmt::print("play: wrote {}: {} frames{} {}x{} at {:g} frames/s, {}{}\n", path, end - first, slice,
+                   width, height, fps, codec == "H.264" ? "H.264 MP4" : "Motion-JPEG AVI",
+                   path != a.out ? " (OpenCV has no H.264 encoder here)" : "");
+    } else {
+        fmt::print("play: wrote {} .. {}: {} frames{} {}x{}\n", sequence->path_for(first),
+                   sequence->path_for(end - 1), end - first, slice, width, height);
+    }
+    fmt::print("play: {}\n{}", session.description(),
+               format_times(session.load_times(), session.frame_totals()));
+}
+
+void add_play_command(CLI::App& root) {
+    auto* sub = root.add_subcommand(
+        "play",
+        "Play a FAP file on a face: headless into a video or frame sequence with --out, else in "
+        "the viewer");
+    auto a = std::make_shared<PlayArgs>();
+    sub->add_option("file", a->fap, "MPEG-4 FAP file (.fap)")->required();
+    sub->add_option("-o,--out", a->out,
+                    "Video (.mp4: H.264 where OpenCV can, else Motion-JPEG .avi; .avi) or frame "
+                    "pattern (frames/%04d.png, numbered by frame). Without it: the viewer");
+    sub->add_option("--size", a->size, "Frame size WIDTHxHEIGHT")->capture_default_str();
+    sub->add_option("--fps", a->fps, "Output frame rate (default: the file's); the animation is resampled");
+    sub->add_option("--frames", a->frames,
+                    "Render the slice A:B of the output frames, B exclusive (0:50 then 50:107 "
+                    "together make 0:107); frame patterns are numbered by frame");
+    add_session_options(*sub, a->session);
+    sub->callback([a] { run_play(*a); });
+}
+
+}  // namespace
+
+EMOFACE_COMMAND(add_play_command)
