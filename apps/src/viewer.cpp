@@ -244,10 +244,14 @@ private:
         const ImGuiIO& io = ImGui::GetIO();
         if (io.WantCaptureMouse) return;
         const float dx = io.MouseDelta.x, dy = io.MouseDelta.y;
-        if (ImGui::IsMouseDragging(ImGuiMouseButton_Left, 0.0f)) camera_.orbit(dx, dy);
-        if (ImGui::IsMouseDragging(ImGuiMouseButton_Right, 0.0f)) light_.drag(dx, dy);
-        if (ImGui::IsMouseDragging(ImGuiMouseButton_Middle, 0.0f))
-            camera_.pan(dx, dy, io.DisplaySize.y);
+        // A drag counts from the frame after the press: the press frame's
+        // delta is the pointer's travel before the button went down.
+        auto dragging = [](ImGuiMouseButton b) {
+            return ImGui::IsMouseDragging(b, 0.0f) && !ImGui::IsMouseClicked(b);
+        };
+        if (dragging(ImGuiMouseButton_Left)) camera_.orbit(dx, dy);
+        if (dragging(ImGuiMouseButton_Right)) light_.drag(dx, dy);
+        if (dragging(ImGuiMouseButton_Middle)) camera_.pan(dx, dy, io.DisplaySize.y);
         if (io.MouseWheel != 0.0f) camera_.zoom(io.MouseWheel);
         if (!io.WantCaptureKeyboard) {
             if (ImGui::IsKeyPressed(GLFW_KEY_R, false)) reset_view();

@@ -290,59 +290,106 @@ TEST_F(ViewUnderXvfb, RendersFramesAndClosesOnItsOwn) {
     EXPECT_FALSE(fs::exists(path("imgui.ini"))) << "no settings file left behind";
 }
 
-TEST_F(ViewUnderXvfb, TheWindowShowsTheFaceAndClosesWhenAsked) {
+// What the X server shows in the viewer's window once it is loaded (the
+// title says "loading" until then), taken when three grabs over a second
+// agree: the picture settled (nothing moves in a view of a still mix).
+bool settled_grab(const std::string& display, double seconds, emoface::apps::testing::WindowShot& grab) {
+    emoface::apps::testing::WindowShot previous;
+    int agreeing = 0;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(long(seconds * 1000));
+    while (agreeing < 3 && std::chrono::steady_clock::now() < deadline) {
+        if (!emoface::apps::testing::grab_window(display, "emoface view", "loading", 1.0, grab)) continue;
+        agreeing = !previous.rgb.empty() && previous.rgb == grab.rgb ? agreeing + 1 : 1;
+        previous = grab;
+        std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    }
+    return agreeing >= 3;
+}
+
+int count_dots(const emoface::apps::testing::WindowShot& grab) {
+    int dots = 0;
+    for (std::size_t i = 0; i < grab.rgb.size(); i += 3) dots += is_dot(&grab.rgb[i]);
+    return dots;
+}
+
+// Pixels of the background's colour (0.16, 0.17, 0.19 sRGB).
+int count_background(const emoface::apps::testing::WindowShot& grab) {
+    int n = 0;
+    for (std::size_t i = 0; i < grab.rgb.size(); i += 3)
+        n += std::abs(grab.rgb[i] - 41) <= 2 && std::abs(grab.rgb[i + 1] - 43) <= 2 &&
+             std::abs(grab.rgb[i + 2] - 48) <= 2;
+    return n;
+}
+
+double fraction_differing(const emoface::apps::testing::WindowShot& a, const emoface::apps::testing::WindowShot& b) {
+    if (a.rgb.size() != b.rgb.size() || a.rgb.empty()) return 1.0;
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < a.rgb.size(); i += 3)
+        n += std::abs(a.rgb[i] - b.rgb[i]) > 8 || std::abs(a.rgb[i + 1] - b.rgb[i + 1]) > 8 ||
+             std::abs(a.rgb[i + 2] - b.rgb[i + 2]) > 8;
+    return double(n) / double(a.rgb.size() / 3);
+}
+
+TEST_F(ViewUnderXvfb, TheWindowFollowsTheMouseAndClosesWhenAsked) {
+    namespace x = emoface::apps::testing;
     const std::string shot = path("shot.png");
     const pid_t pid = start("view --mix '0.7 anger + 0.3 fear' --points --lines --size 480x360 --wrinkle-size 256 "
                             "--screenshot '" + shot + "'",
                             xvfb_->name());
     ASSERT_GT(pid, 0);
-    // What the X server shows once the face is loaded (the title says
-    // "loading" until then), taken when three grabs over a second agree (the
-    // picture settled: nothing moves in this view).
-    emoface::apps::testing::WindowShot grab, previous;
-    int agreeing = 0;
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-    while (agreeing < 3 && std::chrono::steady_clock::now() < deadline) {
-        if (!emoface::apps::testing::grab_window(xvfb_->name(), "emoface view", "loading", 1.0, grab)) continue;
-        agreeing = !previous.rgb.empty() && previous.rgb == grab.rgb ? agreeing + 1 : 1;
-        previous = grab;
-        std::this_thread::sleep_for(std::chrono::milliseconds(500));
-    }
-    const bool settled = agreeing >= 3;
-    if (!settled) {
-        finish(pid, 0);
+    struct Stop {  // never leave the viewer running after a failed assertion
+        pid_t pid;
+        ~Stop() { ViewCommand::finish(pid, 0); }
+    };
+    x::WindowShot frontal;
+    if (!settled_grab(xvfb_->name(), 120, frontal)) {
+        Stop{pid};
         FAIL() << "no settled viewer window within 120 s: " << err();
     }
-    EXPECT_EQ(grab.title, "emoface view: emotion mix");
-    ASSERT_EQ(grab.width, 480);
-    ASSERT_EQ(grab.height, 360);
-    int dots = 0;
-    for (std::size_t i = 0; i < grab.rgb.size(); i += 3) dots += is_dot(&grab.rgb[i]);
-    EXPECT_GT(dots, 100) << "--points draws the feature points in the window";
+    EXPECT_EQ(frontal.title, "emoface view: emotion mix");
+    ASSERT_EQ(frontal.width, 480);
+    ASSERT_EQ(frontal.height, 360);
+    EXPECT_GT(count_dots(frontal), 100) << "--points draws the feature points in the window";
 
-    ASSERT_TRUE(emoface::apps::testing::request_close(xvfb_->name(), "emoface view"));
-    EXPECT_EQ(finish(pid, 60), 0) << "closes when the window manager asks: " << err();
+    // Left-drag across the face (below the folded panel) orbits the camera.
+    x::WindowShot orbited;
+    ASSERT_TRUE(x::drag(xvfb_->name(), "emoface view", 1, 280, 200, 380, 200, 4, 500));
+    ASSERT_TRUE(settled_grab(xvfb_->name(), 60, orbited)) << err();
+    EXPECT_GT(fraction_differing(frontal, orbited), 0.05) << "the face turned";
+    EXPECT_GT(count_dots(orbited), 50) << "the feature points follow the turned face";
 
-    // The screenshot is the frame the window showed.
+    // Wheel up zooms in: the face covers more of the window.
+    x::WindowShot zoomed;
+    ASSERT_TRUE(x::scroll(xvfb_->name(), "emoface view", 280, 200, 3, 500));
+    ASSERT_TRUE(settled_grab(xvfb_->name(), 60, zoomed)) << err();
+    EXPECT_LT(count_background(zoomed), count_background(orbited) * 8 / 10) << "zoomed in";
+
+    ASSERT_TRUE(x::request_close(xvfb_->name(), "emoface view"));
+    EXPECT_EQ(ViewCommand::finish(pid, 60), 0) << "closes when the window manager asks: " << err();
+
+    // The screenshot is the frame the window showed last.
     const ImageRGBA8 img = emoface::render::read_image_rgba8(shot);
-    ASSERT_EQ(img.width, grab.width);
-    ASSERT_EQ(img.height, grab.height);
+    ASSERT_EQ(img.width, zoomed.width);
+    ASSERT_EQ(img.height, zoomed.height);
     int same = 0;
     for (int y = 0; y < img.height; ++y)
         for (int x = 0; x < img.width; ++x) {
             const std::uint8_t* s = img.at(x, y);
-            const std::uint8_t* g = &grab.rgb[(std::size_t(y) * std::size_t(grab.width) + std::size_t(x)) * 3];
+            const std::uint8_t* g = &zoomed.rgb[(std::size_t(y) * std::size_t(zoomed.width) + std::size_t(x)) * 3];
             same += std::abs(s[0] - g[0]) <= 2 && std::abs(s[1] - g[1]) <= 2 && std::abs(s[2] - g[2]) <= 2;
         }
     EXPECT_GT(same, img.width * img.height * 99 / 100) << "screenshot and window agree";
-    if (::testing::Test::HasFailure()) {
-        // Both pictures beside the test's binary, to look at.
-        ImageRGBA8 window(grab.width, grab.height);
-        for (std::size_t i = 0; i < std::size_t(grab.width) * std::size_t(grab.height); ++i) {
-            std::copy_n(&grab.rgb[3 * i], 3, &window.pixels[4 * i]);
-            window.pixels[4 * i + 3] = 255;
+    if (::testing::Test::HasFailure() || std::getenv("EMOFACE_KEEP_VIEWER_SHOTS")) {
+        // The pictures in the working folder, to look at.
+        for (const auto* g : {&frontal, &orbited, &zoomed}) {
+            ImageRGBA8 window(g->width, g->height);
+            for (std::size_t i = 0; i < std::size_t(g->width) * std::size_t(g->height); ++i) {
+                std::copy_n(&g->rgb[3 * i], 3, &window.pixels[4 * i]);
+                window.pixels[4 * i + 3] = 255;
+            }
+            const char* name = g == &frontal ? "frontal" : g == &orbited ? "orbited" : "zoomed";
+            emoface::render::write_image(std::string("viewer_test_") + name + ".png", window);
         }
-        emoface::render::write_image("viewer_test_window.png", window);
         fs::copy_file(shot, "viewer_test_screenshot.png", fs::copy_options::overwrite_existing);
     }
 }

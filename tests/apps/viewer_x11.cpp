@@ -179,6 +179,66 @@ bool grab_window(const std::string& display, const std::string& title_prefix,
     return true;
 }
 
+namespace {
+
+void send_button(Display* d, Window w, int type, unsigned button, int x, int y) {
+    XEvent e;
+    std::memset(&e, 0, sizeof e);
+    e.xbutton.type = type;
+    e.xbutton.display = d;
+    e.xbutton.window = w;
+    e.xbutton.root = DefaultRootWindow(d);
+    e.xbutton.time = CurrentTime;
+    e.xbutton.x = x;
+    e.xbutton.y = y;
+    Window child = 0;
+    XTranslateCoordinates(d, w, e.xbutton.root, x, y, &e.xbutton.x_root, &e.xbutton.y_root, &child);
+    e.xbutton.button = button;
+    e.xbutton.same_screen = True;
+    if (type == ButtonRelease) e.xbutton.state = Button1Mask << (button - 1);
+    XSendEvent(d, w, True, type == ButtonPress ? ButtonPressMask : ButtonReleaseMask, &e);
+    XFlush(d);
+}
+
+void move_pointer(Display* d, Window w, int x, int y, int pause_ms) {
+    XWarpPointer(d, 0, w, 0, 0, 0, 0, x, y);
+    XSync(d, False);
+    std::this_thread::sleep_for(std::chrono::milliseconds(pause_ms));
+}
+
+}  // namespace
+
+bool drag(const std::string& display, const std::string& title_prefix, int button, int x0, int y0, int x1, int y1,
+          int steps, int pause_ms) {
+    Connection c(display);
+    if (!c.display) return false;
+    const Window w = find_window(c.display, title_prefix, "", nullptr);
+    if (!w) return false;
+    move_pointer(c.display, w, x0, y0, pause_ms);
+    send_button(c.display, w, ButtonPress, unsigned(button), x0, y0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(pause_ms));
+    for (int i = 1; i <= steps; ++i)
+        move_pointer(c.display, w, x0 + (x1 - x0) * i / steps, y0 + (y1 - y0) * i / steps, pause_ms);
+    send_button(c.display, w, ButtonRelease, unsigned(button), x1, y1);
+    std::this_thread::sleep_for(std::chrono::milliseconds(pause_ms));
+    return true;
+}
+
+bool scroll(const std::string& display, const std::string& title_prefix, int x, int y, int notches, int pause_ms) {
+    Connection c(display);
+    if (!c.display) return false;
+    const Window w = find_window(c.display, title_prefix, "", nullptr);
+    if (!w) return false;
+    move_pointer(c.display, w, x, y, pause_ms);
+    const unsigned button = notches > 0 ? 4 : 5;
+    for (int i = 0; i < std::abs(notches); ++i) {
+        send_button(c.display, w, ButtonPress, button, x, y);
+        send_button(c.display, w, ButtonRelease, button, x, y);
+        std::this_thread::sleep_for(std::chrono::milliseconds(pause_ms));
+    }
+    return true;
+}
+
 bool request_close(const std::string& display, const std::string& title_prefix) {
     Connection c(display);
     if (!c.display) return false;

@@ -42,6 +42,19 @@ struct WindowShot {
 bool grab_window(const std::string& display, const std::string& title_prefix,
                  const std::string& not_containing, double seconds, WindowShot& shot);
 
+// Mouse input as a person gives it, without the XTest extension: the
+// pointer is warped (real motion events, and XQueryPointer sees it) and the
+// button is pressed and released through synthetic events to the window.
+// Drags button 1 (left), 2 (middle) or 3 (right) from (x0, y0) to (x1, y1)
+// (window pixels) in `steps` moves, `pause_ms` apart so the program under
+// test sees each. False when there is no such window.
+bool drag(const std::string& display, const std::string& title_prefix, int button, int x0, int y0, int x1,
+          int y1, int steps, int pause_ms);
+// `notches` turns of the wheel at (x, y); positive turns away from the user
+// (X buttons 4, or 5 for negative).
+bool scroll(const std::string& display, const std::string& title_prefix, int x, int y, int notches,
+            int pause_ms);
+
 // Sends WM_DELETE_WINDOW to the first window titled `title_prefix`... (the
 // close button of a window manager). False when there is no such window.
 bool request_close(const std::string& display, const std::string& title_prefix);
