@@ -63,15 +63,24 @@ IsoLine to_iso(const Line& l, double sx, double sy) {
     return {l.px * sx, l.py * sy, l.qx * sx, l.qy * sy};
 }
 
-void check_layout(const char* fn, const std::string& what, const Layout& layout, double sx, double sy) {
+bool zero_length(const IsoLine& iso) {
+    const double dx = iso.qx - iso.px, dy = iso.qy - iso.py;
+    return !(dx * dx + dy * dy >= kMinLength * kMinLength);
+}
+
+// Key layouts need every line (a zero-length one has no direction to warp
+// along); a target line may collapse in some pose (a closed lid, a feature a
+// FAP pushes onto another), and then it is skipped for that frame.
+enum class ZeroLength { Error, Skip };
+
+void check_layout(const char* fn, const std::string& what, const Layout& layout, double sx, double sy,
+                  ZeroLength zero = ZeroLength::Error) {
     for (std::size_t i = 0; i < layout.size(); ++i) {
         const Line& l = layout[i];
         if (!finite(l))
             fail<InputError>("morph: {}(): {} line {} has a non-finite coordinate: P = ({}, {}), Q = ({}, {})",
                              fn, what, i, l.px, l.py, l.qx, l.qy);
-        const IsoLine iso = to_iso(l, sx, sy);
-        const double dx = iso.qx - iso.px, dy = iso.qy - iso.py;
-        if (!(dx * dx + dy * dy >= kMinLength * kMinLength))
+        if (zero == ZeroLength::Error && zero_length(to_iso(l, sx, sy)))
             fail<InputError>("morph: {}(): {} line {} has zero length: P = ({}, {}), Q = ({}, {}), "
                              "expected P != Q",
                              fn, what, i, l.px, l.py, l.qx, l.qy);
@@ -133,7 +142,7 @@ struct Morpher::Impl {
         if (static_cast<int>(target.size()) != lines)
             fail<InputError>("morph: {}(): target layout has {} lines, expected {} (the key layouts' count)",
                              fn, target.size(), lines);
-        check_layout(fn, "target", target, sx, sy);
+        check_layout(fn, "target", target, sx, sy, ZeroLength::Skip);
     }
 
     // Builds the line table for the given sources. Weights of the sources
@@ -145,7 +154,6 @@ struct Morpher::Impl {
             plan.source_index[i] = sources[i];
             plan.weight[i] = weights[i];
         }
-        plan.lines = lines;
         plan.record_floats = kernel::record_floats(count);
         plan.law = params.b == 2.0f ? kernel::Law::InverseSquare : kernel::Law::Power;
         plan.b = params.b;
@@ -160,15 +168,17 @@ struct Morpher::Impl {
         // hypot, and pow only for an unusual p, keep it to a few µs.
         records.assign(static_cast<std::size_t>(lines) * plan.record_floats, 0.0f);  // within capacity
         const double a = params.a, p = params.p;
+        int kept = 0;
         for (int i = 0; i < lines; ++i) {
             const IsoLine t = to_iso(target[i], sx, sy);
+            if (zero_length(t)) continue;  // collapsed in this pose: no direction, no say
             const double dx = t.qx - t.px, dy = t.qy - t.py;
             const double len = std::sqrt(dx * dx + dy * dy);
             const double ex = dx / len, ey = dy / len;
             const double nx = -dy / len, ny = dx / len;  // perp(d) / len
             const double mx = 0.5 * (t.px + t.qx), my = 0.5 * (t.py + t.qy);
             const double wk = p == 0.0 ? 1.0 : p == 0.5 ? 1.0 / std::sqrt(len) : p == 1.0 ? 1.0 / len : std::pow(len, -p);
-            float* rec = records.data() + static_cast<std::size_t>(i) * plan.record_floats;
+            float* rec = records.data() + static_cast<std::size_t>(kept++) * plan.record_floats;
             rec[kernel::kEx] = static_cast<float>(ex);
             rec[kernel::kEy] = static_cast<float>(ey);
             rec[kernel::kCs] = static_cast<float>(-(mx * ex + my * ey));
@@ -191,6 +201,7 @@ struct Morpher::Impl {
                 c[5] = static_cast<float>(sdx / slen - ny);
             }
         }
+        plan.lines = kept;
         plan.records = records.data();
     }
 

@@ -441,9 +441,6 @@ std::vector<BadInput> bad_inputs() {
     zero_key[1] = {0.5f, 0.5f, 0.5f, 0.5f};
     Layout nan_key = three;
     nan_key[2].px = std::nanf("");
-    Layout zero_target = three;
-    zero_target[0].qx = zero_target[0].px;
-    zero_target[0].qy = zero_target[0].py;
     Layout inf_target = three;
     inf_target[2].qy = INFINITY;
     MorphParams a0;
@@ -483,8 +480,6 @@ std::vector<BadInput> bad_inputs() {
          "morph: Morpher(): key 1 line 2 has a non-finite coordinate: P = (nan,"},
         {"target line count", frame(random_layout(2, 144), {0.5f, 0.5f}),
          "morph: morph_to_host(): target layout has 2 lines, expected 3 (the key layouts' count)"},
-        {"zero-length target line", frame(zero_target, {0.5f, 0.5f}),
-         "morph: morph_to_host(): target line 0 has zero length"},
         {"infinite target coordinate", frame(inf_target, {0.5f, 0.5f}),
          "morph: morph_to_host(): target line 2 has a non-finite coordinate"},
         {"weight count", frame(three, {1.0f}), "morph: morph_to_host(): 1 weights, expected 2 (one per key map)"},
@@ -514,10 +509,44 @@ std::vector<BadInput> bad_inputs() {
          [=] {
              Morpher m = morpher();
              std::vector<float> out(16 * 16 * 4);
-             m.positions_to_host(zero_target, {}, out.data());
+             m.positions_to_host(inf_target, {}, out.data());
          },
-         "morph: positions_to_host(): target line 0 has zero length"},
+         "morph: positions_to_host(): target line 2 has a non-finite coordinate"},
     };
+}
+
+// A target line that collapses in some pose (a closed lid: upper and lower
+// lid points meet) has no direction to warp along: it is skipped for that
+// frame, which is the same as morphing without it.
+TEST(MorphZeroLengthTarget, ACollapsedTargetLineIsSkippedForThatFrame) {
+    const int w = 32, h = 24;
+    const std::vector<std::uint8_t> a = random_rgba8(w, h, 7), b = random_rgba8(w, h, 8);
+    const Layout la = random_layout(4, 21), lb = jitter(la, 0.03f, 22);
+    Layout target = jitter(la, 0.02f, 23);
+    target[2].qx = target[2].px;
+    target[2].qy = target[2].py;
+    const auto without_line_2 = [](Layout l) {
+        l.erase(l.begin() + 2);
+        return l;
+    };
+    Morpher all(w, h, PixelFormat::Rgba8, {key(a.data(), la), key(b.data(), lb)}, Backend::Cpu);
+    Morpher three(w, h, PixelFormat::Rgba8,
+                  {key(a.data(), without_line_2(la)), key(b.data(), without_line_2(lb))}, Backend::Cpu);
+    std::vector<std::uint8_t> skipped(w * h * 4), reference(w * h * 4);
+    all.morph_to_host(target, {0.6f, 0.4f}, {}, skipped.data());
+    three.morph_to_host(without_line_2(target), {0.6f, 0.4f}, {}, reference.data());
+    EXPECT_EQ(skipped, reference);
+    // Every line collapsed: nothing moves, the keys are blended in place.
+    Layout points = la;
+    for (Line& l : points) l = {l.px, l.py, l.px, l.py};
+    std::vector<float> positions(w * h * 2 * 2);
+    all.positions_to_host(points, {}, positions.data());
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            for (int k = 0; k < 2; ++k) {
+                EXPECT_FLOAT_EQ(positions[((y * w + x) * 2 + k) * 2 + 0], x + 0.5f);
+                EXPECT_FLOAT_EQ(positions[((y * w + x) * 2 + k) * 2 + 1], y + 0.5f);
+            }
 }
 
 TEST(MorphBadInput, EachBadInputIsAClearInputError) {

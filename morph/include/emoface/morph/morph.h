@@ -112,7 +112,8 @@ public:
     std::size_t pixel_bytes() const;  // 4 or 16
     SetupTimes setup_times() const;
 
-    // Each frame: `target` has lines() lines, `weights` keys() entries, each
+    // Each frame: `target` has lines() lines (a target line of zero length,
+    // collapsed in this pose, is skipped for the frame), `weights` keys() entries, each
     // >= 0, summing to at most 1 (a key with weight 0 costs nothing). Bad input
     // throws emoface::InputError before anything is written.
 
