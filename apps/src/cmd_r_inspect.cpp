@@ -6,6 +6,7 @@
 //   emoface inspect --mix "0.7 anger + 0.3 fear" --out overlay.png
 #include <algorithm>
 #include <cstdlib>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -26,7 +27,7 @@ using namespace emoface;
 using namespace emoface::apps;
 
 struct InspectArgs {
-    std::string fap, mix, out, size = "720x720";
+    std::string fap, mix, out, size = "720x720", keys;
     long frame = 0;
     bool raw_map = false, no_labels = false, normalise = false;
     SessionArgs session;
@@ -64,7 +65,7 @@ cv::Mat inspect_picture(Session& session, const expression::FaceState& state, co
 }
 
 std::string state_title(const std::string& source, const expression::FaceState& s) {
-    return fmt::format("{}   mix: {} ({})", source, s.mix.to_string(), expression::mix_source_name(s.mix_source));
+    return fmt::format("{}   mix: {} ({})", source, mix_label(s.mix), expression::mix_source_name(s.mix_source));
 }
 
 void run_inspect(const InspectArgs& a) {
@@ -102,7 +103,7 @@ void run_inspect(const InspectArgs& a) {
         return stream ? session.face_state(stream->frames[std::size_t(frame)]) : session.face_state(mix);
     };
     auto title_now = [&](const expression::FaceState& s) {
-        return stream ? state_title(fmt::format("{} frame {}/{}", a.fap, frame, stream->frames.size() - 1), s)
+        return stream ? state_title(fmt::format("{} frame {}/{}", std::filesystem::path(a.fap).filename().string(), frame, stream->frames.size() - 1), s)
                       : state_title("mix", s);
     };
 
@@ -123,12 +124,19 @@ void run_inspect(const InspectArgs& a) {
     fmt::print("inspect: keys: right/left or d/a step a frame, D/A ten, m encoded/lit map, l labels, "
                "s save inspect_N.png, q or Esc quit\n");
     const long last = stream ? long(stream->frames.size()) - 1 : 0;
+    std::size_t scripted = 0;
     for (;;) {
         const auto state = state_now();
         const cv::Mat picture = inspect_picture(session, state, title_now(state), view);
         cv::imshow(name, picture);
-        int key = cv::waitKeyEx(0);
-        if (key < 0 || cv::getWindowProperty(name, cv::WND_PROP_VISIBLE) < 1) break;
+        int key;
+        if (scripted < a.keys.size()) {
+            cv::waitKey(1);  // lets the window show the picture
+            key = static_cast<unsigned char>(a.keys[scripted++]);
+        } else {
+            key = cv::waitKeyEx(0);
+            if (key < 0 || cv::getWindowProperty(name, cv::WND_PROP_VISIBLE) < 1) break;
+        }
         const int low = key & 0xFFFF;
         if (low == 'q' || low == 27) break;
         if (low == 'd' || low == 0xFF53 || key == 83) frame = std::min(last, frame + 1);
@@ -161,6 +169,7 @@ void add_inspect_command(CLI::App& root) {
         ->capture_default_str();
     sub->add_flag("--raw-map", a->raw_map, "Show the map's encoded normals instead of lighting it");
     sub->add_flag("--no-labels", a->no_labels, "Dots and lines only");
+    sub->add_option("--keys", a->keys, "Window: press these keys first (e.g. \"dDsq\"; for scripts and tests)");
     add_session_options(*sub, a->session);
     sub->callback([a] { run_inspect(*a); });
 }

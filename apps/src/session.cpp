@@ -70,21 +70,31 @@ FrameTimes FrameTimeTotals::mean() const {
 
 std::string format_times(const LoadTimes& load, const FrameTimeTotals& frames) {
     std::string out = fmt::format(
-        "  load ({:.0f} ms): face {:.0f}, rig {:.0f}, profiles+lines {:.0f}, 7 wrinkle keys {:.0f}, "
+        "  load {:.0f} ms: face {:.0f}, rig {:.0f}, profiles + lines {:.0f}, 7 wrinkle keys {:.0f}, "
         "GL context {:.0f}, scene {:.0f}\n",
         load.total(), load.face_ms, load.rig_ms, load.profiles_ms, load.keys_ms, load.platform_ms,
         load.scene_ms);
     if (frames.frames > 0) {
         const FrameTimes m = frames.mean();
+        out += fmt::format("  per frame, mean of {}: {:.1f} ms ({:.1f} frames/s)\n", frames.frames, m.total_ms,
+                           m.total_ms > 0 ? 1000.0 / m.total_ms : 0.0);
         out += fmt::format(
-            "  per frame (mean of {}, {:.1f} ms = {:.1f} frames/s): rig {:.2f}, layout {:.2f}, "
-            "morph {:.2f}, wrinkle UVs {:.2f}, tangents {:.2f}, upload {:.2f}, draw {:.2f}, "
-            "read back {:.2f}\n",
-            frames.frames, m.total_ms, m.total_ms > 0 ? 1000.0 / m.total_ms : 0.0, m.scene.rig_ms,
-            m.scene.layout_ms, m.scene.morph_ms, m.scene.uv_ms, m.scene.tangents_ms,
+            "    rig {:.2f} | layout {:.2f} | morph {:.2f} | wrinkle UVs {:.2f} | tangents {:.2f} | "
+            "upload {:.2f} | draw {:.2f} | read back {:.2f}\n",
+            m.scene.rig_ms, m.scene.layout_ms, m.scene.morph_ms, m.scene.uv_ms, m.scene.tangents_ms,
             m.scene.upload_ms, m.draw_ms, m.readback_ms);
     }
     return out;
+}
+
+std::string mix_label(const expression::EmotionMix& mix) {
+    std::string out;
+    for (const expression::Emotion e : expression::kEmotions) {
+        const double w = mix[e];
+        if (!(w >= 0.005)) continue;
+        out += fmt::format("{}{:.2f} {}", out.empty() ? "" : " + ", w, expression::emotion_name(e));
+    }
+    return out.empty() ? "neutral" : out;
 }
 
 fap::FapStream load_fap_stream(const std::string& path) {

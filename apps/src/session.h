@@ -100,6 +100,9 @@ struct FrameTimeTotals {
 // Lines of "stage   mean ms" for a report: loading, then per frame.
 std::string format_times(const LoadTimes& load, const FrameTimeTotals& frames);
 
+// "0.70 anger + 0.30 fear" (two decimals; "neutral" for none): for labels.
+std::string mix_label(const expression::EmotionMix& mix);
+
 // Reads a FAP file for playing; InputError when it has no frames or its
 // frame rate is not positive.
 fap::FapStream load_fap_stream(const std::string& path);

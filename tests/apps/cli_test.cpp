@@ -299,6 +299,20 @@ TEST_F(AppsCli, InspectWritesRenderAndMapSideBySide) {
     EXPECT_EQ(b.height, 160 + 30);
 }
 
+// The OpenCV window (CTest runs this again under xvfb-run): keys step the
+// frame (d +1, D +10) and s saves the picture of the frame shown.
+TEST_F(AppsCli, InspectWindowStepsWithKeys) {
+    const char* display = std::getenv("DISPLAY");
+    if (!display || !*display) GTEST_SKIP() << "no display (apps_inspect_window_under_xvfb runs it under Xvfb)";
+    const CommandResult r = run("inspect" + kTourArg + " --keys dDsq --size 160x160" + kFast,
+                                "cd '" + (dir_ / "out").string() + "' &&");
+    ASSERT_EQ(r.rc, 0) << r.err;
+    EXPECT_EQ(outputs(), std::vector<std::string>{"inspect_11.png"}) << r.out;
+    const ImageRGBA8 shot = emoface::render::read_image_rgba8(path("inspect_11.png"));
+    EXPECT_EQ(shot.width, 160 + 6 + 160);
+    EXPECT_EQ(shot.height, 160 + 30);
+}
+
 TEST_F(AppsCli, MorphWritesTheFigureAndTheStageTimes) {
     const CommandResult r =
         run("morph --from anger --to surprise --steps 3 --tile 64 --out '" + path("sheet.png") + "'" + kFast);
