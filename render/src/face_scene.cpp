@@ -209,8 +209,16 @@ bool FaceScene::uses_interop() const { return wrinkle_morph_->uses_interop(); }
 int FaceScene::key_count() const { return morpher_->keys(); }
 
 void FaceScene::update(const expression::FapValues& faps, const std::vector<float>& key_weights) {
-    update_geometry(faps);
+    // The layout needs only the feature points (cheap), so the morph is
+    // queued first: on the CUDA backend it then runs on the GPU while the
+    // CPU deforms the mesh and uploads it (the draw waits for both).
+    auto t = Clock::now();
+    layout_ = layout_of(rig_.feature_points(faps), present_points(face_), box_);
+    target_ = to_morph_layout(expression::layout_segments(lines_, layout_));
+    const double layout_ms = ms_since(t);
     update_wrinkles(key_weights);
+    deform(faps, /*layout_from_mesh=*/false);
+    times_.layout_ms = layout_ms;
 }
 
 void FaceScene::update_wrinkles(const std::vector<float>& key_weights) {
@@ -221,16 +229,22 @@ void FaceScene::update_wrinkles(const std::vector<float>& key_weights) {
 }
 
 void FaceScene::update_geometry(const expression::FapValues& faps) {
+    deform(faps, /*layout_from_mesh=*/true);
+}
+
+void FaceScene::deform(const expression::FapValues& faps, bool layout_from_mesh) {
     platform_.make_current();
     auto t = Clock::now();
     rig_.deform(faps, deformed_);
     expression::FaceRig::write_to(deformed_, mesh_);
     times_.rig_ms = ms_since(t);
 
-    t = Clock::now();
-    layout_ = layout_of(deformed_.feature_points, present_points(face_), box_);
-    target_ = to_morph_layout(expression::layout_segments(lines_, layout_));
-    times_.layout_ms = ms_since(t);
+    if (layout_from_mesh) {
+        t = Clock::now();
+        layout_ = layout_of(deformed_.feature_points, present_points(face_), box_);
+        target_ = to_morph_layout(expression::layout_segments(lines_, layout_));
+        times_.layout_ms = ms_since(t);
+    }
 
     times_.uv_ms = times_.tangents_ms = times_.upload_ms = 0.0;
     const auto* full_points = mesh_.points();

@@ -91,7 +91,8 @@ public:
 
     // One frame: the face deformed by `faps`, the keys blended by
     // `key_weights` (one per key, each >= 0, sum <= 1) onto the frame's layout.
-    // Same as update_geometry(faps) then update_wrinkles(key_weights).
+    // The layout first, then the morph is queued (on the GPU it overlaps
+    // the CPU work that follows), then update_geometry(faps).
     void update(const expression::FapValues& faps, const std::vector<float>& key_weights);
     // The geometry half: rig, layout L*, wrinkle UVs, tangents, vertex upload.
     void update_geometry(const expression::FapValues& faps);
@@ -120,6 +121,10 @@ public:
 
 private:
     struct Part;
+    // Rig, wrinkle UVs, tangents, upload; and L* from the deformed feature
+    // points when asked.
+    void deform(const expression::FapValues& faps, bool layout_from_mesh);
+
     Platform& platform_;
     const expression::Face& face_;
     const expression::FaceRig& rig_;
