@@ -517,11 +517,14 @@ private:
         const auto& layout = session_.layout();
         ImDrawList* dl = ImGui::GetWindowDrawList();
         const float h = side * float(tex.height()) / float(tex.width());
+        // L* points outside the map (the crown, the neck) are cut at its edge.
+        dl->PushClipRect(origin, ImVec2(origin.x + side, origin.y + h), true);
         for (int i = 0; i < expression::kFeatureCount; ++i)
             if (layout.present[std::size_t(i)])
                 dl->AddCircleFilled(ImVec2(origin.x + layout.points[std::size_t(i)].x * side,
                                            origin.y + layout.points[std::size_t(i)].y * h),
                                     1.5f, IM_COL32(255, 60, 40, 255));
+        dl->PopClipRect();
     }
 
     const ViewerOptions& options_;
