@@ -1,5 +1,7 @@
 #include "session.h"
 
+#include "emoface/render/wrinkle_keys_io.h"
+
 #include <algorithm>
 #include <bitset>
 #include <chrono>
@@ -156,6 +158,8 @@ void add_session_options(CLI::App& sub, SessionArgs& a) {
     sub.add_option("--wrinkle-size", o.wrinkle_size, "Side of the wrinkle maps (256..4096)")->capture_default_str();
     sub.add_option("--samples", o.samples, "Multisampling samples")->check(CLI::Range(1, 16))->capture_default_str();
     sub.add_flag("--no-wrinkles", a.no_wrinkles, "Draw without the wrinkle maps");
+    sub.add_option("--wrinkles", o.wrinkle_folder,
+                   "Folder of key wrinkle maps + layouts (as `emoface wrinkles` writes; maps may be painted)");
     sub.add_option("--face-resolution", o.face_resolution,
                    "Mesh resolution of the default face (0.1..2; smaller loads and draws faster)")
         ->capture_default_str();
@@ -241,10 +245,14 @@ Session::Session(const SessionOptions& options, render::Platform* window) : opti
     // The seven keys, each at its own expression's full intensity (neutral:
     // no FAPs); independent, so generated side by side.
     t = Clock::now();
+    if (!options_.wrinkle_folder.empty()) {
+        a.keys = render::read_wrinkle_keys(options_.wrinkle_folder, a.lines);
+        options_.wrinkle_size = a.keys.front().map.width;
+    }
     std::vector<std::future<render::WrinkleKey>> keys;
     const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
     a.keys.resize(expression::kWrinkleKeyCount);
-    for (int k = 0; k < expression::kWrinkleKeyCount; ++k) {
+    for (int k = 0; k < expression::kWrinkleKeyCount && options_.wrinkle_folder.empty(); ++k) {
         auto make = [&a, &spec, k, size = options_.wrinkle_size] {
             expression::FapValues pose{};
             if (k > 0) pose = a.emotions.profiles[std::size_t(k - 1)];
@@ -252,7 +260,7 @@ Session::Session(const SessionOptions& options, render::Platform* window) : opti
         };
         keys.push_back(std::async(threads > 1 ? std::launch::async : std::launch::deferred, make));
     }
-    for (int k = 0; k < expression::kWrinkleKeyCount; ++k) a.keys[std::size_t(k)] = keys[std::size_t(k)].get();
+    for (std::size_t k = 0; k < keys.size(); ++k) a.keys[k] = keys[k].get();
     load_.keys_ms = ms_since(t);
 
     t = Clock::now();

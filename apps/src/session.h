@@ -51,6 +51,9 @@ struct SessionOptions {
     int samples = 4;
     // The default face's mesh resolution (1 = face.json's) and base-colour
     // size (0 = face.json's): smaller loads faster (tests, quick looks).
+    // A folder of key wrinkle maps with their layouts (as `emoface wrinkles`
+    // writes it, possibly with painted maps): used instead of generating them.
+    std::string wrinkle_folder;
     double face_resolution = 1.0;
     int texture_size = 0;
 };

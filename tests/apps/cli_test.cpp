@@ -339,4 +339,40 @@ TEST_F(AppsCli, PlaysTheRealXfaceAngerFile) {
     EXPECT_NE(r.out.find(std::to_string(frames) + " frames"), std::string::npos) << r.out;
 }
 
+// `emoface wrinkles` writes the seven maps and layouts; the same folder, with
+// a map replaced by a "painted" one, drives the pipeline unchanged.
+TEST_F(AppsCli, WrinklesWritesKeysThatThePipelineReadsBack) {
+    const std::string folder = path("keys");
+    CommandResult r = run("wrinkles --size 256 --out '" + folder + "'");
+    ASSERT_EQ(r.rc, 0) << r.err;
+    for (const char* key : {"neutral", "joy", "sadness", "anger", "fear", "disgust", "surprise"}) {
+        const ImageRGBA8 map = emoface::render::read_image_rgba8(folder + "/" + key + ".png");
+        EXPECT_EQ(map.width, 256) << key;
+        EXPECT_TRUE(fs::exists(folder + "/" + std::string(key) + ".layout.json")) << key;
+    }
+    r = run("mix \"anger=1\" --wrinkles '" + folder + "' --out '" + path("generated.png") + "'" + kSmall);
+    ASSERT_EQ(r.rc, 0) << r.err;
+    // The artist flattens the anger map: the render loses its anger wrinkles.
+    ImageRGBA8 flat(256, 256);
+    for (int i = 0; i < 256 * 256; ++i) {
+        flat.pixels[i * 4 + 0] = flat.pixels[i * 4 + 1] = 128;
+        flat.pixels[i * 4 + 2] = flat.pixels[i * 4 + 3] = 255;
+    }
+    emoface::render::write_image(folder + "/anger.png", flat);
+    r = run("mix \"anger=1\" --wrinkles '" + folder + "' --out '" + path("painted.png") + "'" + kSmall);
+    ASSERT_EQ(r.rc, 0) << r.err;
+    EXPECT_GT(mean_difference(emoface::render::read_image_rgba8(path("generated.png")),
+                              emoface::render::read_image_rgba8(path("painted.png"))),
+              0.01);  // renders are deterministic: 0 had the folder been ignored
+    // A folder that lacks a map is bad input, and nothing is written.
+    fs::remove(folder + "/fear.png");
+    r = run("mix \"anger=1\" --wrinkles '" + folder + "' --out '" + path("broken.png") + "'" + kSmall);
+    EXPECT_EQ(r.rc, 2);
+    EXPECT_NE(r.err.find("fear.png: missing wrinkle map"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(path("broken.png")));
+    r = run("wrinkles --size 100 --out '" + path("small") + "'");
+    EXPECT_EQ(r.rc, 2);
+    EXPECT_NE(r.err.find("--size must be 256..4096, found 100"), std::string::npos) << r.err;
+}
+
 }  // namespace
