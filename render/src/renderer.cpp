@@ -12,6 +12,7 @@
 #include "emoface/render/wrinkle_texture.h"
 #include "gl_util.h"
 #include "shaders.h"
+#include "skin_maps.h"
 
 namespace emoface::render {
 
@@ -127,6 +128,49 @@ GLuint upload_srgb_texture(const ImageRGBA8& image) {
     return t;
 }
 
+// The pre-integrated scattering table: clamped, bilinear, RGB half floats.
+constexpr int kScatterTableWidth = 128;   // N.L
+constexpr int kScatterTableHeight = 64;   // curvature
+GLuint upload_scatter_table(const SkinShading& skin) {
+    const std::vector<float> table =
+        detail::preintegrated_scatter_table(skin, kScatterTableWidth, kScatterTableHeight);
+    GLuint t = 0;
+    glGenTextures(1, &t);
+    glBindTexture(GL_TEXTURE_2D, t);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB16F, kScatterTableWidth, kScatterTableHeight, 0, GL_RGB,
+                 GL_FLOAT, table.data());
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    check_gl("uploading the scattering table");
+    return t;
+}
+
+// The pore map: repeating, mipmapped (filtered pores shorten the normal, which
+// the shader turns into roughness).
+GLuint upload_pore_map(const PoreMapSpec& spec) {
+    const std::vector<std::uint8_t> texels = detail::pore_map(spec);
+    GLuint t = 0;
+    glGenTextures(1, &t);
+    glBindTexture(GL_TEXTURE_2D, t);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, spec.size, spec.size, 0, GL_RGBA, GL_UNSIGNED_BYTE,
+                 texels.data());
+    glGenerateMipmap(GL_TEXTURE_2D);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    check_gl("uploading the pore map");
+    return t;
+}
+
 }  // namespace
 
 struct Renderer::Impl {
@@ -148,9 +192,16 @@ struct Renderer::Impl {
         GLint model, normal_matrix, view_projection, base_map, has_base_map, base_color,
             wrinkle_map, use_wrinkle_map, wrinkle_signed, light_position, light_ambient,
             light_diffuse, light_specular, specular_color, shininess, camera_position, projective,
-            box;
+            box, skin_model, skin_surface, scatter_table, max_curvature, mm_per_unit,
+            normal_softening, cavity_direct, pore_map, pore_tiles, pore_strength, f0, roughness,
+            lobe_weight, fill_direction, fill_colour, rim_direction, rim_colour, sky, ground,
+            exposure, tone_map;
     } loc{};
     std::vector<Mesh> meshes;
+    // The skin model's tables, made on the first skin draw and again when
+    // the parameters they come from change.
+    GLuint scatter_table = 0, pore_texture = 0;
+    SkinShading scatter_source, pore_source;
 
     explicit Impl(Platform& p) : platform(p) {}
 
@@ -166,6 +217,32 @@ struct Renderer::Impl {
         glDeleteBuffers(4, buffers);
         if (m.vao) glDeleteVertexArrays(1, &m.vao);
         m.base_texture = m.vao = m.shape_vbo = m.frame_vbo = m.static_vbo = m.ebo = 0;
+    }
+
+    // Binds the scattering table to unit 2 and the pore map to unit 3,
+    // remaking either when its parameters changed (each made on its own
+    // unit: an upload binds and unbinds the active unit's texture).
+    void bind_skin_tables(const SkinShading& skin) {
+        glActiveTexture(GL_TEXTURE2);
+        const bool same_scatter = scatter_table && skin.profile == scatter_source.profile &&
+                                  skin.max_curvature == scatter_source.max_curvature;
+        if (!same_scatter) {
+            const GLuint t = upload_scatter_table(skin);
+            if (scatter_table) glDeleteTextures(1, &scatter_table);
+            scatter_table = t;
+            scatter_source = skin;
+        }
+        glActiveTexture(GL_TEXTURE3);
+        if (!pore_texture || !(skin.pores == pore_source.pores)) {
+            const GLuint t = upload_pore_map(skin.pores);
+            if (pore_texture) glDeleteTextures(1, &pore_texture);
+            pore_texture = t;
+            pore_source = skin;
+        }
+        glActiveTexture(GL_TEXTURE2);
+        glBindTexture(GL_TEXTURE_2D, scatter_table);
+        glActiveTexture(GL_TEXTURE3);
+        glBindTexture(GL_TEXTURE_2D, pore_texture);
     }
 };
 
@@ -193,6 +270,27 @@ Renderer::Renderer(Platform& platform) : impl_(std::make_unique<Impl>(platform))
     l.camera_position = u("u_camera_position");
     l.projective = u("u_projective");
     l.box = u("u_box");
+    l.skin_model = u("u_skin_model");
+    l.skin_surface = u("u_skin_surface");
+    l.scatter_table = u("u_scatter_table");
+    l.max_curvature = u("u_max_curvature");
+    l.mm_per_unit = u("u_mm_per_unit");
+    l.normal_softening = u("u_normal_softening");
+    l.cavity_direct = u("u_cavity_direct");
+    l.pore_map = u("u_pore_map");
+    l.pore_tiles = u("u_pore_tiles");
+    l.pore_strength = u("u_pore_strength");
+    l.f0 = u("u_f0");
+    l.roughness = u("u_roughness");
+    l.lobe_weight = u("u_lobe_weight");
+    l.fill_direction = u("u_fill_direction");
+    l.fill_colour = u("u_fill_colour");
+    l.rim_direction = u("u_rim_direction");
+    l.rim_colour = u("u_rim_colour");
+    l.sky = u("u_sky");
+    l.ground = u("u_ground");
+    l.exposure = u("u_exposure");
+    l.tone_map = u("u_tone_map");
     check_gl("Renderer: creating the program");
 }
 
@@ -200,6 +298,8 @@ Renderer::~Renderer() {
     if (!impl_) return;
     impl_->platform.make_current();
     for (auto& m : impl_->meshes) impl_->release(m);
+    if (impl_->scatter_table) glDeleteTextures(1, &impl_->scatter_table);
+    if (impl_->pore_texture) glDeleteTextures(1, &impl_->pore_texture);
     if (impl_->program) glDeleteProgram(impl_->program);
 }
 
@@ -404,10 +504,36 @@ void Renderer::draw(const DrawOptions& o, const WrinkleTexture* wrinkle_map) {
     glBindTexture(GL_TEXTURE_2D, wrinkle_map ? wrinkle_map->gl_texture() : 0);
     glUniform1i(im.loc.wrinkle_signed,
                 wrinkle_map && wrinkle_map->encoding() == NormalEncoding::Signed);
+    const bool skin_model = o.shading == Shading::Skin;
+    glUniform1i(im.loc.skin_model, skin_model ? 1 : 0);
+    if (skin_model) {
+        const SkinShading& k = o.skin;
+        im.bind_skin_tables(k);
+        glUniform1i(im.loc.scatter_table, 2);
+        glUniform1i(im.loc.pore_map, 3);
+        glUniform1f(im.loc.max_curvature, k.max_curvature);
+        glUniform1f(im.loc.mm_per_unit, k.mm_per_unit);
+        glUniform3fv(im.loc.normal_softening, 1, glm::value_ptr(k.normal_softening));
+        glUniform1f(im.loc.cavity_direct, k.cavity_direct);
+        glUniform1f(im.loc.pore_tiles, k.pore_tiles);
+        glUniform1f(im.loc.pore_strength, k.pore_strength);
+        glUniform1f(im.loc.f0, k.f0);
+        glUniform2f(im.loc.roughness, k.roughness[0], k.roughness[1]);
+        glUniform1f(im.loc.lobe_weight, k.lobe_weight);
+        glUniform3fv(im.loc.fill_direction, 1, glm::value_ptr(k.fill.direction));
+        glUniform3fv(im.loc.fill_colour, 1, glm::value_ptr(k.fill.colour));
+        glUniform3fv(im.loc.rim_direction, 1, glm::value_ptr(k.rim.direction));
+        glUniform3fv(im.loc.rim_colour, 1, glm::value_ptr(k.rim.colour));
+        glUniform3fv(im.loc.sky, 1, glm::value_ptr(k.sky));
+        glUniform3fv(im.loc.ground, 1, glm::value_ptr(k.ground));
+        glUniform1f(im.loc.exposure, k.exposure);
+        glUniform1i(im.loc.tone_map, k.tone_mapping == ToneMapping::Aces ? 1 : 0);
+    }
 
     for (const auto& m : im.meshes) {
         const bool bump = o.wrinkles && wrinkle_map && m.material.uses_wrinkle_map;
         glUniform1i(im.loc.use_wrinkle_map, bump ? 1 : 0);
+        glUniform1i(im.loc.skin_surface, m.material.uses_wrinkle_map ? 1 : 0);
         glUniform1i(im.loc.has_base_map, m.base_texture ? 1 : 0);
         glUniform3fv(im.loc.base_color, 1, glm::value_ptr(m.material.base_color));
         glUniform3fv(im.loc.specular_color, 1, glm::value_ptr(m.material.specular_color));
@@ -418,6 +544,12 @@ void Renderer::draw(const DrawOptions& o, const WrinkleTexture* wrinkle_map) {
         glDrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
     }
     glBindVertexArray(0);
+    if (skin_model) {
+        glActiveTexture(GL_TEXTURE3);
+        glBindTexture(GL_TEXTURE_2D, 0);
+        glActiveTexture(GL_TEXTURE2);
+        glBindTexture(GL_TEXTURE_2D, 0);
+    }
     glActiveTexture(GL_TEXTURE1);
     glBindTexture(GL_TEXTURE_2D, 0);
     glActiveTexture(GL_TEXTURE0);

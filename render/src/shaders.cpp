@@ -52,9 +52,16 @@ void main() {
 }
 )GLSL";
 
-// Fragment stage: thesis 5.5.1's Blinn-Phong, in linear light, written out
-// sRGB-encoded (the framebuffer is plain RGBA8, so the encoding is the same
-// on every GL and the PNG holds what was computed).
+// Fragment stage, two models (renderer.h, skin_shading.h):
+//   thesis: 5.5.1's Blinn-Phong in linear light, written out sRGB-encoded
+//           (the framebuffer is plain RGBA8, so the encoding is the same on
+//           every GL and the PNG holds what was computed);
+//   skin:   pre-integrated scattering, two GGX lobes with Fresnel, pores,
+//           cavity and specular occlusion, a key/fill/rim/hemisphere rig,
+//           exposure and tone mapping, then the same sRGB encoding.
+// Light intensities follow the thesis's convention: a light of colour I
+// lights a white Lambert surface facing it to I (I = E / pi), so a BRDF f
+// contributes pi f (N.L) I.
 const char* const kBumpFragmentShader = R"GLSL(#version 330 core
 in vec3 v_position;
 in vec3 v_normal;
@@ -65,7 +72,7 @@ in vec2 v_base_uv;
 uniform sampler2D u_base_map;     // sRGB texture: sampled as linear
 uniform bool u_has_base_map;
 uniform vec3 u_base_color;        // linear
-uniform sampler2D u_wrinkle_map;
+uniform sampler2D u_wrinkle_map;  // rgb normal, a cavity (1 = none)
 uniform bool u_use_wrinkle_map;
 uniform bool u_wrinkle_signed;    // texel = n (float maps) or 0.5 + 0.5 n
 
@@ -77,7 +84,32 @@ uniform vec3 u_specular_color;
 uniform float u_shininess;
 uniform vec3 u_camera_position;
 
+// Skin model (u_skin_model false: thesis Blinn-Phong).
+uniform bool u_skin_model;
+uniform bool u_skin_surface;        // this mesh is skin (else a wet, glossy part)
+uniform sampler2D u_scatter_table;  // N.L x curvature -> rgb diffuse
+uniform float u_max_curvature;      // 1/mm at the table's top row
+uniform float u_mm_per_unit;
+uniform vec3 u_normal_softening;
+uniform float u_cavity_direct;
+uniform sampler2D u_pore_map;       // rgb normal, a cavity
+uniform float u_pore_tiles;
+uniform float u_pore_strength;
+uniform float u_f0;
+uniform vec2 u_roughness;
+uniform float u_lobe_weight;
+uniform vec3 u_fill_direction;
+uniform vec3 u_fill_colour;
+uniform vec3 u_rim_direction;
+uniform vec3 u_rim_colour;
+uniform vec3 u_sky;
+uniform vec3 u_ground;
+uniform float u_exposure;
+uniform bool u_tone_map;
+
 out vec4 frag_color;
+
+const float PI = 3.14159265;
 
 vec3 srgb_encode(vec3 c) {
     c = clamp(c, 0.0, 1.0);
@@ -86,13 +118,169 @@ vec3 srgb_encode(vec3 c) {
     return mix(lo, hi, step(vec3(0.0031308), c));
 }
 
+// ACES filmic fit (Narkowicz 2015): 0 -> 0, monotonic, rolls off to 1.
+vec3 tone_map(vec3 x) {
+    x = max(x, vec3(0.0));
+    return clamp((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0);
+}
+
+// Schlick's Fresnel.
+float fresnel(float f0, float cos_theta) {
+    float m = 1.0 - clamp(cos_theta, 0.0, 1.0);
+    float m2 = m * m;
+    return f0 + (1.0 - f0) * m2 * m2 * m;
+}
+
+// GGX D times the height-correlated Smith visibility G / (4 N.L N.V).
+float ggx_dv(float a, float n_dot_h, float n_dot_l, float n_dot_v) {
+    float a2 = a * a;
+    float d = n_dot_h * n_dot_h * (a2 - 1.0) + 1.0;
+    float dist = a2 / (PI * d * d);
+    float gv = n_dot_l * sqrt(n_dot_v * n_dot_v * (1.0 - a2) + a2);
+    float gl = n_dot_v * sqrt(n_dot_l * n_dot_l * (1.0 - a2) + a2);
+    return dist * 0.5 / max(gv + gl, 1e-6);
+}
+
+// Split-sum environment BRDF, analytic fit (Karis 2014, "mobile").
+float environment_brdf(float f0, float roughness, float n_dot_v) {
+    const vec4 c0 = vec4(-1.0, -0.0275, -0.572, 0.022);
+    const vec4 c1 = vec4(1.0, 0.0425, 1.04, -0.04);
+    vec4 r = roughness * c0 + c1;
+    float a004 = min(r.x * r.x, exp2(-9.28 * n_dot_v)) * r.x + r.y;
+    vec2 ab = vec2(-1.04, 1.04) * a004 + r.zw;
+    return f0 * ab.x + ab.y;
+}
+
+// Lagarde & de Rousiers 2014: reflections fade inside an occluded cavity.
+float specular_occlusion(float n_dot_v, float ao, float roughness) {
+    return clamp(pow(n_dot_v + ao, exp2(-16.0 * roughness - 1.0)) - 1.0 + ao, 0.0, 1.0);
+}
+
+vec3 hemisphere(vec3 dir) {
+    return mix(u_ground, u_sky, 0.5 + 0.5 * dir.y);
+}
+
+struct Surface {
+    vec3 n;          // shading normal (bumped, pores)
+    vec3 n_geo;      // interpolated geometric normal
+    vec3 v;          // towards the eye
+    vec3 albedo;
+    float curvature; // table row coordinate in [0, 1]
+    float f0;
+    vec2 alpha;      // GGX alpha of the two lobes
+    float lobe_weight;
+    float cavity;    // 1 open skin, 0 a deep crevice
+};
+
+// One light's contribution (colour `c`, direction `l` towards it).
+vec3 shade_light(Surface s, vec3 l, vec3 c) {
+    float n_dot_v = max(dot(s.n, s.v), 1e-4);
+    vec3 diffuse;
+    if (u_skin_surface) {
+        // Each channel sees a normal softened towards the geometric one.
+        vec3 nl;
+        nl.r = dot(normalize(mix(s.n, s.n_geo, u_normal_softening.r)), l);
+        nl.g = dot(normalize(mix(s.n, s.n_geo, u_normal_softening.g)), l);
+        nl.b = dot(normalize(mix(s.n, s.n_geo, u_normal_softening.b)), l);
+        vec3 u = clamp(0.5 + 0.5 * nl, 0.0, 1.0);
+        diffuse = vec3(texture(u_scatter_table, vec2(u.r, s.curvature)).r,
+                       texture(u_scatter_table, vec2(u.g, s.curvature)).g,
+                       texture(u_scatter_table, vec2(u.b, s.curvature)).b);
+        diffuse *= mix(1.0, s.cavity, u_cavity_direct);
+    } else {
+        diffuse = vec3(max(dot(s.n, l), 0.0));
+    }
+    // Light that the surface reflects does not enter it.
+    vec3 color = diffuse * s.albedo * (1.0 - fresnel(s.f0, n_dot_v));
+    float n_dot_l = dot(s.n, l);
+    if (n_dot_l > 0.0) {
+        vec3 h = normalize(l + s.v);
+        float n_dot_h = max(dot(s.n, h), 0.0);
+        float lobes = s.lobe_weight * ggx_dv(s.alpha.x, n_dot_h, n_dot_l, n_dot_v) +
+                      (1.0 - s.lobe_weight) * ggx_dv(s.alpha.y, n_dot_h, n_dot_l, n_dot_v);
+        color += vec3(PI * lobes * fresnel(s.f0, dot(l, h)) * n_dot_l);
+    }
+    return color * c;
+}
+
+vec3 shade_skin(vec3 n_bumped, vec3 n_geo, vec3 base, float cavity) {
+    Surface s;
+    s.n_geo = n_geo;
+    s.v = normalize(u_camera_position - v_position);
+    s.albedo = base;
+    s.cavity = cavity;
+    vec2 roughness;
+    if (u_skin_surface) {
+        roughness = u_roughness;
+        s.lobe_weight = u_lobe_weight;
+        // Pores, in the frame of the base UVs built from screen derivatives
+        // (Schueler 2006); their filtered normal's shortening (Toksvig)
+        // widens the lobes where pores are smaller than a pixel.
+        vec2 uv = v_base_uv * u_pore_tiles;
+        vec4 pore = texture(u_pore_map, uv);
+        vec3 pn = pore.rgb * 2.0 - 1.0;
+        float shortening = clamp(length(pn), 1e-3, 1.0);
+        vec3 dp1 = dFdx(v_position), dp2 = dFdy(v_position);
+        vec2 duv1 = dFdx(uv), duv2 = dFdy(uv);
+        vec3 dp2perp = cross(dp2, n_bumped), dp1perp = cross(n_bumped, dp1);
+        vec3 t = dp2perp * duv1.x + dp1perp * duv2.x;
+        vec3 b = dp2perp * duv1.y + dp1perp * duv2.y;
+        float scale = max(dot(t, t), dot(b, b));
+        s.n = n_bumped;
+        if (scale > 1e-20) {
+            scale = inversesqrt(scale);
+            vec3 tilted = n_bumped * pn.z + u_pore_strength * scale * (t * pn.x + b * pn.y);
+            if (dot(tilted, tilted) > 1e-12) s.n = normalize(tilted);
+        }
+        float variance = u_pore_strength * u_pore_strength * (1.0 - shortening) / shortening;
+        roughness = sqrt(clamp(roughness * roughness + vec2(variance), 0.0, 1.0));
+        s.cavity = cavity * pore.a;
+        // Curvature of the geometric surface (Penner): |dN| / |dP| in 1/mm.
+        float dn = length(fwidth(n_geo));
+        float dp = length(fwidth(v_position)) * u_mm_per_unit;
+        s.curvature = clamp(dn / max(dp, 1e-6) / u_max_curvature, 0.0, 1.0);
+    } else {
+        // Eyes, mouth: one lobe of the roughness matching the Blinn-Phong
+        // exponent (Walter et al. 2007: alpha = sqrt(2 / (s + 2))).
+        float alpha = sqrt(2.0 / (u_shininess + 2.0));
+        roughness = vec2(sqrt(alpha));
+        s.lobe_weight = 1.0;
+        s.n = n_bumped;
+        s.curvature = 0.0;
+    }
+    s.alpha = max(roughness * roughness, vec2(1e-3));
+    // The cavity dims F0 (Jimenez et al. 2013): crevices lose their sheen.
+    s.f0 = u_f0 * s.cavity;
+
+    vec3 key = u_light_position.w == 0.0 ? normalize(u_light_position.xyz)
+                                         : normalize(u_light_position.xyz - v_position);
+    vec3 color = shade_light(s, key, u_light_diffuse);
+    color += shade_light(s, normalize(u_fill_direction), u_fill_colour);
+    color += shade_light(s, normalize(u_rim_direction), u_rim_colour);
+
+    // The sky/ground hemisphere: diffuse from the softest normal, specular
+    // by the environment BRDF towards the reflection, both occluded in the
+    // cavity.
+    float n_dot_v = max(dot(s.n, s.v), 1e-4);
+    vec3 ambient_n = u_skin_surface ? normalize(mix(s.n, n_geo, u_normal_softening.r)) : s.n;
+    color += hemisphere(ambient_n) * s.albedo * s.cavity * (1.0 - fresnel(s.f0, n_dot_v));
+    float mean_roughness = mix(roughness.y, roughness.x, s.lobe_weight);
+    color += hemisphere(reflect(-s.v, s.n)) * environment_brdf(s.f0, mean_roughness, n_dot_v) *
+             specular_occlusion(n_dot_v, s.cavity, mean_roughness);
+    return color;
+}
+
 void main() {
     float facing = gl_FrontFacing ? 1.0 : -1.0;
     vec3 vn = facing * v_normal;
     vec3 n = normalize(vn);
+    vec3 n_geo = n;
+    float cavity = 1.0;
     if (u_use_wrinkle_map) {
-        vec3 t = texture(u_wrinkle_map, v_wrinkle_uv).rgb;
+        vec4 texel = texture(u_wrinkle_map, v_wrinkle_uv);
+        vec3 t = texel.rgb;
         if (!u_wrinkle_signed) t = t * 2.0 - 1.0;   // thesis 4.3: [0,1] -> [-1,1]
+        cavity = clamp(texel.a, 0.0, 1.0);
         // MikkTSpace's pixel-shader rule: unnormalised interpolated frame,
         // bitangent rebuilt from the handedness.
         vec3 vt = facing * v_tangent.xyz;
@@ -100,11 +288,17 @@ void main() {
         vec3 bumped = t.x * vt + t.y * vb + t.z * vn;
         if (dot(bumped, bumped) > 1e-12) n = normalize(bumped);
     }
-    vec3 l = u_light_position.w == 0.0 ? normalize(u_light_position.xyz)
-                                       : normalize(u_light_position.xyz - v_position);
     vec3 base = u_base_color;
     if (u_has_base_map) base *= texture(u_base_map, v_base_uv).rgb;
 
+    if (u_skin_model) {
+        vec3 color = u_exposure * shade_skin(n, n_geo, base, cavity);
+        frag_color = vec4(srgb_encode(u_tone_map ? tone_map(color) : color), 1.0);
+        return;
+    }
+
+    vec3 l = u_light_position.w == 0.0 ? normalize(u_light_position.xyz)
+                                       : normalize(u_light_position.xyz - v_position);
     float n_dot_l = max(0.0, dot(n, l));
     // The thesis adds the light's ambient colour as is; here it is modulated
     // by the base colour, so the unlit side keeps the skin's hue.

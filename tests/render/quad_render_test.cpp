@@ -1,8 +1,10 @@
 // The renderer against lighting computed by hand: a flat quad filling a
 // headless frame, a 16x16 normal map with a different tangent-space normal in
 // each quadrant, a constant sRGB base texture. At the centre of each quadrant
-// the pixel must be thesis 5.5.1's Blinn-Phong of the decoded normal brought
-// to world space through T, B = w N x T, N, encoded to sRGB.
+// the pixel must be thesis 5.5.1's Blinn-Phong (Shading::Thesis) of the
+// decoded normal brought to world space through T, B = w N x T, N, encoded
+// to sRGB. The skin model is checked for its properties on the same quad:
+// energy bounded, Fresnel rising at grazing angles, a monotonic tone curve.
 #include <cmath>
 #include <memory>
 #include <string>
@@ -172,7 +174,7 @@ protected:
 };
 std::unique_ptr<HeadlessPlatform> QuadRender::platform_;
 
-TEST_P(QuadRender, PixelsMatchBlinnPhongByHand) {
+TEST_P(QuadRender, ThesisShadingMatchesBlinnPhongByHand) {
     const Case& c = GetParam();
     Platform& platform = *platform_;
     Renderer renderer(platform);
@@ -201,6 +203,7 @@ TEST_P(QuadRender, PixelsMatchBlinnPhongByHand) {
     options.camera = ortho_camera();
     options.light = c.light;
     options.wrinkles = c.wrinkles;
+    options.shading = Shading::Thesis;
     platform.begin_frame();
     renderer.draw(options, &map);
     platform.end_frame();

@@ -3,8 +3,12 @@
 // mesh. Per pixel: base colour from the mesh's own UVs (sRGB texture, decoded
 // to linear); the normal from the wrinkle map (a second, per-frame UV set)
 // brought to world space through the tangent frame (MikkTSpace: B = w N x T);
-// Blinn-Phong as in thesis 5.5.1 (ambient + diffuse N.L + specular (N.H)^s,
-// the specular term only where N.L > 0); output encoded to sRGB.
+// then one of two shading models (DrawOptions::shading):
+//   Shading::Thesis  Blinn-Phong as in thesis 5.5.1 (ambient + diffuse N.L +
+//                    specular (N.H)^s, the specular term only where N.L > 0);
+//   Shading::Skin    the skin model of skin_shading.h (scattering, two GGX
+//                    lobes with Fresnel, pores, cavities, a light rig, ACES);
+// output encoded to sRGB.
 // The renderer draws into whatever framebuffer is bound: a Platform's, after
 // begin_frame().
 #include <array>
@@ -19,6 +23,7 @@
 
 #include "emoface/expression/mesh.h"
 #include "emoface/render/image.h"
+#include "emoface/render/skin_shading.h"
 #include "emoface/render/tangents.h"
 
 namespace emoface::render {
@@ -26,7 +31,9 @@ namespace emoface::render {
 class Platform;
 class WrinkleTexture;
 
-// Colours are linear RGB.
+// Colours are linear RGB. In skin shading the light is the rig's key light,
+// of colour `diffuse` (for both reflections, as one physical light); the rig
+// (SkinShading) replaces `ambient`, and `specular` is not used.
 struct Light {
     // w = 0: a directional light, xyz the direction towards the light;
     // w = 1: a point light at xyz (world space). As in fixed-function GL.
@@ -59,16 +66,28 @@ struct Material {
     // (unlike the wrinkle UVs, whose v runs down the image; see
     // wrinkle_texture.h). null: base_color alone.
     std::shared_ptr<const ImageRGBA8> base_texture;
-    // Whether this mesh is bump-mapped with the wrinkle map (skin: yes,
-    // eyeballs: no).
+    // Whether this mesh is skin: bump-mapped with the wrinkle map and, in
+    // skin shading, drawn with the skin model (eyeballs, mouth: no; those are
+    // drawn as wet tissue, Lambert and one GGX lobe of the roughness that
+    // matches `shininess`).
     bool uses_wrinkle_map = true;
+    // Blinn-Phong (thesis shading) only.
     glm::vec3 specular_color{1.0f};
     float shininess = 24.0f;
+};
+
+enum class Shading {
+    Thesis,  // thesis 5.5.1's Blinn-Phong (figure 6.4's reproduction)
+    Skin,    // skin_shading.h
 };
 
 struct DrawOptions {
     Camera camera;
     Light light;
+    Shading shading = Shading::Skin;
+    // The skin model's parameters and the rest of its light rig
+    // (data/render/skin.json); Shading::Skin only.
+    SkinShading skin{};
     glm::mat4 model{1.0f};
     // false draws every mesh with its geometric normal (the side-by-side
     // comparison "without wrinkles").

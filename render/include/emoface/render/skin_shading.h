@@ -1,0 +1,129 @@
+#pragma once
+// The parameters of the skin shading model (Renderer, Shading::Skin) and its
+// default light rig. The values people tune live in data/render/skin.json,
+// each with its source (docs FIDELITY.md section 5); the defaults below are
+// that file's values (a test keeps them in step), so a program that loads
+// nothing still draws the same skin.
+//
+// The model, per pixel:
+//   diffuse   pre-integrated subsurface scattering (Penner & Borshukov 2011):
+//             a lookup table of the d'Eon-Luebke diffusion profile integrated
+//             over a ring of curvature 1/r, indexed by N.L and the surface's
+//             curvature (from screen-space derivatives); per colour channel a
+//             normal softened towards the geometric one (red scatters farthest);
+//   specular  two GGX lobes (roughness a, b; weight of a) with Schlick Fresnel
+//             from F0 (skin n = 1.4 gives 0.028); F0 scaled by the cavity
+//             (wrinkle map alpha, pore pits) so cavities lose their sheen;
+//   pores     a tiled, deterministic pore normal map generated at load
+//             (mipmapped; the length of its filtered normal widens the lobes,
+//             Toksvig, so pores too small to see still roughen the sheen);
+//   light     the draw's key light, a fill and a rim light, a sky/ground
+//             hemisphere with specular occlusion (Lagarde & de Rousiers 2014)
+//             in the cavities; the sum is exposed, tone mapped (ACES fit,
+//             Narkowicz 2015) and encoded to sRGB.
+#include <array>
+#include <string>
+
+#include <glm/vec3.hpp>
+
+namespace emoface::render {
+
+// One Gaussian of the sum-of-Gaussians diffusion profile
+// R(d) = sum_i weight_i * exp(-d^2 / (2 v_i)) / (2 pi v_i), d in mm.
+struct ScatterGaussian {
+    float variance_mm2 = 0.0f;
+    glm::vec3 weight{0.0f};
+    bool operator==(const ScatterGaussian& o) const {
+        return variance_mm2 == o.variance_mm2 && weight == o.weight;
+    }
+};
+
+// A directional light of the rig: direction towards the light (world space,
+// need not be unit length), linear RGB intensity (1 lights a white Lambert
+// surface facing it to 1).
+struct RigLight {
+    glm::vec3 direction{0.0f, 0.0f, 1.0f};
+    glm::vec3 colour{0.0f};
+    bool operator==(const RigLight& o) const {
+        return direction == o.direction && colour == o.colour;
+    }
+};
+
+// The procedural pore map: a square tile of `size` texels holding a
+// jittered grid of `cells` x `cells` pits (a cell of `cells`-th of the tile)
+// over a fine value noise.
+struct PoreMapSpec {
+    int size = 256;
+    int cells = 28;
+    float pit_radius = 0.32f;   // of a cell
+    float pit_depth = 1.0f;     // relative to the noise's amplitude (1)
+    float noise_scale = 0.35f;  // amplitude of the fine noise beside the pits
+    unsigned seed = 1u;
+    bool operator==(const PoreMapSpec& o) const {
+        return size == o.size && cells == o.cells && pit_radius == o.pit_radius &&
+               pit_depth == o.pit_depth && noise_scale == o.noise_scale && seed == o.seed;
+    }
+};
+
+enum class ToneMapping {
+    Aces,  // ACES filmic fit (Narkowicz 2015): monotonic, 0 -> 0, highlights roll off
+    None,  // linear, clamped to [0, 1] (measurements, tests)
+};
+
+struct SkinShading {
+    // --- diffuse: pre-integrated scattering ---
+    // d'Eon & Luebke 2007 (GPU Gems 3 ch. 14), six Gaussians.
+    std::array<ScatterGaussian, 6> profile{{
+        {0.0064f, {0.233f, 0.455f, 0.649f}},
+        {0.0484f, {0.100f, 0.336f, 0.344f}},
+        {0.187f, {0.118f, 0.198f, 0.000f}},
+        {0.567f, {0.113f, 0.007f, 0.007f}},
+        {1.99f, {0.358f, 0.004f, 0.000f}},
+        {7.41f, {0.078f, 0.000f, 0.000f}},
+    }};
+    // Curvature range of the lookup table (1/mm); flatter is Lambert.
+    float max_curvature = 0.5f;
+    // Millimetres per scene unit (the default face is modelled in mm).
+    float mm_per_unit = 1.0f;
+    // How far each channel's diffuse normal leans from the bumped normal to
+    // the geometric one (Penner's softened normals: red scatters farthest).
+    glm::vec3 normal_softening{0.5f, 0.2f, 0.1f};
+    // How much the wrinkle cavity darkens direct diffuse light (ambient light
+    // is darkened fully).
+    float cavity_direct = 0.5f;
+
+    // --- specular: two GGX lobes with Fresnel ---
+    float f0 = 0.028f;
+    std::array<float, 2> roughness{0.38f, 0.18f};
+    float lobe_weight = 0.85f;  // of roughness[0]; the other lobe gets the rest
+
+    // --- pores ---
+    PoreMapSpec pores{};
+    float pore_tiles = 48.0f;    // pore tiles per unit of the base UVs
+    float pore_strength = 0.6f;  // scale of the pore normals' tilt
+
+    // --- light rig (the key light is the draw's Light) ---
+    RigLight fill{{0.7f, 0.1f, 0.7f}, {0.16f, 0.17f, 0.19f}};
+    RigLight rim{{0.5f, 0.6f, -0.65f}, {0.55f, 0.52f, 0.48f}};
+    glm::vec3 sky{0.22f, 0.23f, 0.25f};     // ambient from above (+y)
+    glm::vec3 ground{0.10f, 0.08f, 0.07f};  // ambient from below (warm bounce)
+    float exposure = 1.0f;
+    ToneMapping tone_mapping = ToneMapping::Aces;
+
+    bool operator==(const SkinShading& o) const {
+        return profile == o.profile && max_curvature == o.max_curvature &&
+               mm_per_unit == o.mm_per_unit && normal_softening == o.normal_softening &&
+               cavity_direct == o.cavity_direct && f0 == o.f0 && roughness == o.roughness &&
+               lobe_weight == o.lobe_weight && pores == o.pores && pore_tiles == o.pore_tiles &&
+               pore_strength == o.pore_strength && fill == o.fill && rim == o.rim &&
+               sky == o.sky && ground == o.ground && exposure == o.exposure &&
+               tone_mapping == o.tone_mapping;
+    }
+    bool operator!=(const SkinShading& o) const { return !(*this == o); }
+};
+
+// Reads data/render/skin.json (every key required; keys starting with _
+// are comments). Throws emoface::InputError naming the file and the key.
+SkinShading load_skin_shading(const std::string& path);
+
+}  // namespace emoface::render

@@ -1,0 +1,157 @@
+#include "skin_maps.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "emoface/common/error.h"
+
+namespace emoface::render::detail {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// The ring integrals of one Gaussian of the profile, for a point whose normal
+// makes angle theta with the light on a circle of radius r (mm): numerator
+// (light arriving along the ring, clamped cosine) and denominator (the ring's
+// weight). The Gaussian is sampled over +-6 sigma of arc (or the whole ring).
+void ring_integrals(double variance, double theta, double r, double* num, double* den) {
+    const double sigma = std::sqrt(variance);
+    const double half = std::min(kPi * r, 6.0 * sigma);
+    constexpr int kSteps = 96;
+    const double ds = 2.0 * half / kSteps;
+    double n = 0.0, d = 0.0;
+    for (int k = 0; k < kSteps; ++k) {
+        const double s = -half + (k + 0.5) * ds;  // arc length from the point
+        const double chord = 2.0 * r * std::sin(s / (2.0 * r));
+        const double g = std::exp(-chord * chord / (2.0 * variance)) / (2.0 * kPi * variance);
+        n += std::max(0.0, std::cos(theta + s / r)) * g;
+        d += g;
+    }
+    *num = n * ds;
+    *den = d * ds;
+}
+
+std::uint32_t hash3(std::uint32_t x, std::uint32_t y, std::uint32_t seed) {
+    std::uint32_t h = x * 374761393u + y * 668265263u + seed * 2246822519u;
+    h = (h ^ (h >> 13)) * 1274126177u;
+    return h ^ (h >> 16);
+}
+double unit(std::uint32_t h) { return double(h & 0xffffffu) / double(0xffffffu); }
+
+// Value noise of period `period` lattice cells (tileable).
+double periodic_noise(double x, double y, int period, std::uint32_t seed) {
+    const int xi = int(std::floor(x)), yi = int(std::floor(y));
+    const double fx = x - xi, fy = y - yi;
+    auto fade = [](double t) { return t * t * (3.0 - 2.0 * t); };
+    auto at = [&](int i, int j) {
+        const int a = ((i % period) + period) % period, b = ((j % period) + period) % period;
+        return unit(hash3(std::uint32_t(a), std::uint32_t(b), seed));
+    };
+    const double u = fade(fx), v = fade(fy);
+    const double top = at(xi, yi) + (at(xi + 1, yi) - at(xi, yi)) * u;
+    const double bottom = at(xi, yi + 1) + (at(xi + 1, yi + 1) - at(xi, yi + 1)) * u;
+    return top + (bottom - top) * v;
+}
+
+}  // namespace
+
+std::vector<float> preintegrated_scatter_table(const SkinShading& skin, int width, int height) {
+    if (width < 2 || height < 2 || !(skin.max_curvature > 0.0f))
+        fail("render: scatter table {}x{} with curvature up to {}", width, height,
+             skin.max_curvature);
+    std::vector<float> out(std::size_t(width) * height * 3);
+    for (int j = 0; j < height; ++j) {
+        const double curvature = (j + 0.5) / height * skin.max_curvature;
+        const double r = 1.0 / curvature;
+        for (int i = 0; i < width; ++i) {
+            const double n_dot_l = -1.0 + 2.0 * (i + 0.5) / width;
+            const double theta = std::acos(std::clamp(n_dot_l, -1.0, 1.0));
+            double num[3] = {0, 0, 0}, den[3] = {0, 0, 0};
+            for (const ScatterGaussian& g : skin.profile) {
+                if (!(g.variance_mm2 > 0.0f)) continue;
+                double gn = 0, gd = 0;
+                ring_integrals(g.variance_mm2, theta, r, &gn, &gd);
+                for (int c = 0; c < 3; ++c) {
+                    num[c] += g.weight[c] * gn;
+                    den[c] += g.weight[c] * gd;
+                }
+            }
+            float* px = &out[(std::size_t(j) * width + i) * 3];
+            for (int c = 0; c < 3; ++c)
+                px[c] = den[c] > 0.0 ? float(num[c] / den[c]) : float(std::max(0.0, n_dot_l));
+        }
+    }
+    return out;
+}
+
+std::vector<std::uint8_t> pore_map(const PoreMapSpec& spec) {
+    if (spec.size < 8 || spec.size > 2048 || spec.size % 4 != 0 || spec.cells < 1 ||
+        spec.cells > spec.size / 2)
+        fail("render: pore map of {} texels (a multiple of 4 in 8..2048) with {} cells (1..size/2)",
+             spec.size, spec.cells);
+    const int n = spec.size;
+    const double cell = double(n) / spec.cells;
+    std::vector<double> height(std::size_t(n) * n, 0.0), pit(std::size_t(n) * n, 0.0);
+    // Pit centres and radii, one per cell, jittered.
+    std::vector<double> cx(std::size_t(spec.cells) * spec.cells), cy(cx.size()), radius(cx.size());
+    for (int j = 0; j < spec.cells; ++j)
+        for (int i = 0; i < spec.cells; ++i) {
+            const std::size_t k = std::size_t(j) * spec.cells + i;
+            const std::uint32_t h = hash3(std::uint32_t(i), std::uint32_t(j), spec.seed);
+            cx[k] = (i + 0.15 + 0.7 * unit(h)) * cell;
+            cy[k] = (j + 0.15 + 0.7 * unit(hash3(h, 17u, spec.seed))) * cell;
+            radius[k] = spec.pit_radius * cell * (0.6 + 0.8 * unit(hash3(h, 29u, spec.seed)));
+        }
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+            const int ci = int(x / cell), cj = int(y / cell);
+            double depth = 0.0;
+            for (int dj = -1; dj <= 1; ++dj)
+                for (int di = -1; di <= 1; ++di) {
+                    // Neighbouring cells across the tile's edge wrap around.
+                    const int i = ((ci + di) % spec.cells + spec.cells) % spec.cells;
+                    const int j = ((cj + dj) % spec.cells + spec.cells) % spec.cells;
+                    const std::size_t k = std::size_t(j) * spec.cells + i;
+                    double dx = x + 0.5 - cx[k], dy = y + 0.5 - cy[k];
+                    dx -= n * std::round(dx / n);
+                    dy -= n * std::round(dy / n);
+                    const double q = (dx * dx + dy * dy) / (radius[k] * radius[k]);
+                    if (q < 1.0) depth = std::max(depth, (1.0 - q) * (1.0 - q));
+                }
+            // Fine relief: two octaves of value noise on lattices of 4 and
+            // 2 texels, whose periods divide the tile.
+            const double f = 0.65 * periodic_noise(x / 4.0, y / 4.0, n / 4, spec.seed + 7u) +
+                             0.35 * periodic_noise(x / 2.0, y / 2.0, n / 2, spec.seed + 11u);
+            const std::size_t idx = std::size_t(y) * n + x;
+            pit[idx] = depth;
+            height[idx] = spec.noise_scale * f - spec.pit_depth * depth;
+        }
+    // Normals from central differences (wrapping), scaled so the steepest
+    // slope tilts the normal by 45 degrees; the shader scales the tilt.
+    std::vector<double> gx(height.size()), gy(height.size());
+    double steepest = 1e-12;
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+            auto h = [&](int xx, int yy) {
+                return height[std::size_t((yy + n) % n) * n + std::size_t((xx + n) % n)];
+            };
+            const std::size_t idx = std::size_t(y) * n + x;
+            gx[idx] = 0.5 * (h(x + 1, y) - h(x - 1, y));
+            gy[idx] = 0.5 * (h(x, y + 1) - h(x, y - 1));
+            steepest = std::max(steepest, std::hypot(gx[idx], gy[idx]));
+        }
+    std::vector<std::uint8_t> out(std::size_t(n) * n * 4);
+    auto byte = [](double v) { return std::uint8_t(std::lround(std::clamp(v, 0.0, 1.0) * 255.0)); };
+    for (std::size_t idx = 0; idx < height.size(); ++idx) {
+        double nx = -gx[idx] / steepest, ny = -gy[idx] / steepest, nz = 1.0;
+        const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
+        nx /= len; ny /= len; nz /= len;
+        out[idx * 4 + 0] = byte(0.5 + 0.5 * nx);
+        out[idx * 4 + 1] = byte(0.5 + 0.5 * ny);
+        out[idx * 4 + 2] = byte(0.5 + 0.5 * nz);
+        out[idx * 4 + 3] = byte(1.0 - 0.6 * pit[idx]);
+    }
+    return out;
+}
+
+}  // namespace emoface::render::detail
