@@ -19,6 +19,7 @@
 #include "emoface/common/error.h"
 #include "emoface/fap/feature_points.h"
 #include "face_params.h"
+#include "json_reader.h"
 #include "face_shape.h"
 #include "face_texture.h"
 
@@ -774,19 +775,19 @@ void Generator::place_feature_points(Face& face) {
     set_free("7.1", {p_.head_pivot[0], p_.head_pivot[1], p_.head_pivot[2]});
 
     for (const auto& [id, target] : p_.feature_targets) {
+        const FileLoc at{p_.file, 0, detail::json_key_path("feature_points", id)};
         const auto k = fap::find_feature_point(id);
-        if (!k) fail<InputError>("expression: {}: feature_points: \"{}\" is not an MPEG-4 feature point", p_.file, id);
-        if (placed[*k])
-            fail<InputError>("expression: {}: feature_points: \"{}\" is placed by the generator; remove it", p_.file, id);
+        if (!k) fail_data("expression", at, "an MPEG-4 feature point id as the key", "\"" + id + "\"");
+        if (placed[*k]) fail_data("expression", at, "a point the generator does not place", "one it places (remove it)");
         const int v = target.size() == 2 ? nearest_front(target[0], target[1])
                                          : nearest_3d({target[0], target[1], target[2]});
-        if (v < 0) fail<InputError>("expression: {}: feature_points: no front-facing skin near \"{}\"", p_.file, id);
+        if (v < 0) fail_data("expression", at, "a target near front-facing skin", "none there");
         set_vertex(id.c_str(), v);
     }
-    for (int k = 0; k < 84; ++k)
+    for (int k = 0; k < fap::kFeaturePointCount; ++k)
         if (!placed[k])
-            fail<InputError>("expression: {}: feature_points: no target for \"{}\"", p_.file,
-                             std::string(fap::feature_points()[k].id));
+            fail_data("expression", FileLoc{p_.file, 0, "feature_points"},
+                      fmt::format("a target for \"{}\"", fap::feature_points()[k].id), "none");
 }
 
 Face Generator::build(int texture_size) {

@@ -10,15 +10,16 @@ Ellipsoid read_ellipsoid(JsonReader r) {
     e.centre = r.numbers<3>("centre");
     e.radii = r.numbers<3>("radii");
     e.tilt_deg = r.number("tilt_deg", 0.0);
-    r.finish();
     for (double v : e.radii)
-        if (!(v > 0.0)) fail<InputError>("expression: {}: ellipsoid radii must be positive", r.file());
+        if (!(v > 0.0)) r.at("radii").fail("3 positive radii");
+    r.finish();
     return e;
 }
 
 std::vector<RowKey> read_row_keys(JsonReader& r, const std::string& key) {
     std::vector<RowKey> keys;
-    for (JsonReader k : r.objects(key)) {
+    const std::vector<JsonReader> objects = r.objects(key);
+    for (JsonReader k : objects) {
         RowKey rk;
         rk.origin_y = k.number("origin_y");
         const auto z = k.numbers<2>("origin_z");
@@ -29,13 +30,11 @@ std::vector<RowKey> read_row_keys(JsonReader& r, const std::string& key) {
         rk.angle_back_deg = a[1];
         rk.spacing = k.number("spacing", 0.0);
         if (rk.spacing < 0 || (rk.spacing > 0 && rk.spacing < 0.2))
-            fail<InputError>("expression: {}: \"{}\": spacing must be at least 0.2 mm, found {}", r.file(),
-                             r.where(key), rk.spacing);
+            k.at("spacing").fail("0 (the resolution's spacing) or at least 0.2 mm");
         k.finish();
         keys.push_back(rk);
     }
-    if (keys.size() < 2)
-        fail<InputError>("expression: {}: \"{}\" needs at least 2 keys", r.file(), r.where(key));
+    if (keys.size() < 2) r.at(key).fail("at least 2 row keys", std::to_string(keys.size()));
     return keys;
 }
 
@@ -47,9 +46,8 @@ Bump read_bump(JsonReader b) {
     out.height = b.number("height");
     out.angle_deg = b.number("angle_deg", 0.0);
     out.mirror = b.boolean("mirror", false);
+    if (!(out.radius[0] > 0.0 && out.radius[1] > 0.0)) b.at("radius").fail("2 positive radii");
     b.finish();
-    if (!(out.radius[0] > 0.0 && out.radius[1] > 0.0))
-        fail<InputError>("expression: {}: bump \"{}\" needs positive radii", b.file(), out.name);
     return out;
 }
 
@@ -60,188 +58,166 @@ Vec3 colour(JsonReader& r, const std::string& key) { return r.numbers<3>(key); }
 FaceParams read_face_params(const std::string& params_dir) {
     FaceParams p;
     p.file = params_dir + "/face.json";
-    const nlohmann::json root = read_json_file(p.file);
-    JsonReader top(root, p.file, "");
-
-    {
-        JsonReader r = top.object("resolution");
-        p.front_columns = r.integer("front_columns");
-        p.back_columns = r.integer("back_columns");
-        p.front_half_angle_deg = r.number("front_half_angle_deg");
-        p.row_spacing = r.number("row_spacing_mm");
-        if (!(p.row_spacing >= 0.2 && p.row_spacing <= 50))
-            fail<InputError>("expression: {}: row_spacing_mm must be in [0.2, 50]", p.file);
-        p.upper_rows = read_row_keys(r, "upper_rows");
-        p.lower_rows = read_row_keys(r, "lower_rows");
-        p.eyeball_rings = r.integer("eyeball_rings");
-        p.eyeball_segments = r.integer("eyeball_segments");
-        p.texture_size = r.integer("texture_size");
-        r.finish();
-        if (p.front_columns < 8 || p.back_columns < 4 || p.front_columns > 4000 || p.back_columns > 4000)
-            fail<InputError>("expression: {}: resolution columns out of range", p.file);
-        if (p.texture_size < 16 || p.texture_size > 8192)
-            fail<InputError>("expression: {}: texture_size must be in [16, 8192]", p.file);
-        if (p.eyeball_rings < 6 || p.eyeball_segments < 8 || p.eyeball_rings > 512 || p.eyeball_segments > 512)
-            fail<InputError>("expression: {}: eyeball resolution out of range", p.file);
-    }
-    {
-        JsonReader r = top.object("head");
-        p.skull = read_ellipsoid(r.object("skull"));
-        p.lower_face = read_ellipsoid(r.object("lower_face"));
-        p.jaw = read_ellipsoid(r.object("jaw"));
-        JsonReader neck = r.object("neck");
-        p.neck_centre_z = neck.number("centre_z");
-        p.neck_radii = neck.numbers<2>("radii");
-        p.neck_top_y = neck.number("top_y");
-        p.neck_blend = neck.number("blend");
-        neck.finish();
-        p.blend = r.number("blend");
-        r.finish();
-    }
-    {
-        JsonReader r = top.object("eyes");
-        p.eye_centre = r.numbers<3>("centre");
-        p.eye_radius = r.number("radius");
-        p.iris_radius = r.number("iris_radius");
-        p.pupil_radius = r.number("pupil_radius");
-        p.inner_corner = r.numbers<2>("inner_corner");
-        p.outer_corner = r.numbers<2>("outer_corner");
-        p.upper_lid_height = r.number("upper_lid_height");
-        p.lower_lid_height = r.number("lower_lid_height");
-        p.upper_lid_peak = r.number("upper_lid_peak");
-        p.lower_lid_peak = r.number("lower_lid_peak");
-        p.lid_clearance = r.number("lid_clearance");
-        p.lid_thickness = r.number("lid_thickness");
-        p.lid_blend_inner = r.number("lid_blend_inner");
-        p.lid_blend_outer = r.number("lid_blend_outer");
-        p.lid_warp_reach = r.number("lid_warp_reach");
-        r.finish();
-        if (!(p.eye_radius > 0 && p.iris_radius > p.pupil_radius && p.pupil_radius > 0 &&
-              p.iris_radius < p.eye_radius))
-            fail<InputError>("expression: {}: eyes need radius > iris_radius > pupil_radius > 0", p.file);
-        if (!(p.outer_corner[0] > p.inner_corner[0] && p.inner_corner[0] > 0))
-            fail<InputError>("expression: {}: eyes.outer_corner must be further left than inner_corner (x > 0)",
-                             p.file);
-    }
-    {
-        JsonReader r = top.object("mouth");
-        p.mouth_y = r.number("centre_y");
-        p.mouth_half_width = r.number("half_width");
-        p.mouth_corner_rise = r.number("corner_rise");
-        p.upper_lip_height = r.number("upper_lip_height");
-        p.lower_lip_height = r.number("lower_lip_height");
-        p.cupid_dip = r.number("cupid_dip");
-        p.cupid_peak_x = r.number("cupid_peak_x");
-        p.upper_lip_protrusion = r.number("upper_lip_protrusion");
-        p.lower_lip_protrusion = r.number("lower_lip_protrusion");
-        p.lip_crease_depth = r.number("crease_depth");
-        p.lip_crease_width = r.number("crease_width");
-        p.mouth_warp_reach = r.number("warp_reach");
-        p.outer_corner_offset = r.number("outer_corner_offset");
-        r.finish();
-        if (!(p.mouth_half_width > 0 && p.upper_lip_height > 0 && p.lower_lip_height > 0))
-            fail<InputError>("expression: {}: mouth sizes must be positive", p.file);
-    }
-    {
-        JsonReader r = top.object("mouth_interior");
-        p.cavity_centre = r.numbers<3>("cavity_centre");
-        p.cavity_radii = r.numbers<3>("cavity_radii");
-        p.teeth_half_width = r.number("teeth_half_width");
-        p.teeth_height = r.number("teeth_height");
-        p.teeth_depth = r.number("teeth_depth");
-        p.teeth_gap = r.number("teeth_gap");
-        p.tongue_centre = r.numbers<3>("tongue_centre");
-        p.tongue_radii = r.numbers<3>("tongue_radii");
-        r.finish();
-    }
-    for (JsonReader b : top.objects("bumps")) p.bumps.push_back(read_bump(b));
-    for (JsonReader b : top.objects("nostrils")) p.nostrils.push_back(read_bump(b));
-    for (JsonReader rr : top.objects("ridges")) {
-        Ridge ridge;
-        ridge.name = rr.string("name");
-        const nlohmann::json& pts = rr.raw("points");
-        if (!pts.is_array() || pts.size() < 2)
-            fail<InputError>("expression: {}: ridge \"{}\" needs at least 2 points", p.file, ridge.name);
-        for (const auto& pt : pts) {
-            if (!pt.is_array() || pt.size() != 2 || !pt[0].is_number() || !pt[1].is_number())
-                fail<InputError>("expression: {}: ridge \"{}\": points must be [x, y] pairs", p.file, ridge.name);
-            ridge.points.push_back({pt[0].get<double>(), pt[1].get<double>()});
+    read_json_file(p.file, [&](JsonReader& top) {
+        {
+            JsonReader r = top.object("resolution");
+            p.front_columns = r.integer_in("front_columns", 8, 4000);
+            p.back_columns = r.integer_in("back_columns", 4, 4000);
+            p.front_half_angle_deg = r.number("front_half_angle_deg");
+            p.row_spacing = r.number_in("row_spacing_mm", 0.2, 50);
+            p.upper_rows = read_row_keys(r, "upper_rows");
+            p.lower_rows = read_row_keys(r, "lower_rows");
+            p.eyeball_rings = r.integer_in("eyeball_rings", 6, 512);
+            p.eyeball_segments = r.integer_in("eyeball_segments", 8, 512);
+            p.texture_size = r.integer_in("texture_size", 16, 8192);
+            r.finish();
         }
-        ridge.width = rr.number_list("width");
-        ridge.height = rr.number_list("height");
-        ridge.mirror = rr.boolean("mirror", false);
-        rr.finish();
-        if (ridge.width.size() != ridge.points.size() || ridge.height.size() != ridge.points.size())
-            fail<InputError>("expression: {}: ridge \"{}\": width and height need one value per point", p.file,
-                             ridge.name);
-        for (double w : ridge.width)
-            if (!(w > 0.0))
-                fail<InputError>("expression: {}: ridge \"{}\": widths must be positive", p.file, ridge.name);
-        p.ridges.push_back(std::move(ridge));
-    }
-    {
-        JsonReader r = top.object("ears");
-        p.ear_centre_yz = r.numbers<2>("centre_yz");
-        p.ear_radii_yz = r.numbers<2>("radii_yz");
-        p.ear_height = r.number("height");
-        r.finish();
-    }
-    {
-        JsonReader r = top.object("pivots");
-        p.jaw_pivot = r.numbers<3>("jaw");
-        p.head_pivot = r.numbers<3>("head");
-        r.finish();
-    }
-    {
-        JsonReader r = top.object("texture_box");
-        p.texture_box_min = r.numbers<2>("min");
-        p.texture_box_max = r.numbers<2>("max");
-        r.finish();
-    }
-    {
-        const nlohmann::json& fps = top.raw("feature_points");
-        if (!fps.is_object()) fail<InputError>("expression: {}: \"feature_points\" must be an object", p.file);
-        for (auto it = fps.begin(); it != fps.end(); ++it) {
-            if (!it.key().empty() && it.key()[0] == '_') continue;
-            std::vector<double> v;
-            if (it->is_array())
-                for (const auto& e : *it)
-                    if (e.is_number()) v.push_back(e.get<double>());
-            if (v.size() != 2 && v.size() != 3)
-                fail<InputError>("expression: {}: feature_points.\"{}\" must be [x, y] or [x, y, z]", p.file,
-                                 it.key());
-            p.feature_targets[it.key()] = v;
+        {
+            JsonReader r = top.object("head");
+            p.skull = read_ellipsoid(r.object("skull"));
+            p.lower_face = read_ellipsoid(r.object("lower_face"));
+            p.jaw = read_ellipsoid(r.object("jaw"));
+            JsonReader neck = r.object("neck");
+            p.neck_centre_z = neck.number("centre_z");
+            p.neck_radii = neck.numbers<2>("radii");
+            p.neck_top_y = neck.number("top_y");
+            p.neck_blend = neck.number("blend");
+            neck.finish();
+            p.blend = r.number("blend");
+            r.finish();
         }
-    }
-    {
-        JsonReader r = top.object("colours");
-        p.skin = colour(r, "skin");
-        p.lips = colour(r, "lips");
-        p.brows = colour(r, "brows");
-        p.hair = colour(r, "hair");
-        p.iris = colour(r, "iris");
-        p.sclera = colour(r, "sclera");
-        p.mouth = colour(r, "mouth");
-        p.teeth = colour(r, "teeth");
-        p.tongue = colour(r, "tongue");
-        r.finish();
-    }
-    {
-        JsonReader r = top.object("brows");
-        p.brow_points = {r.numbers<2>("inner"), r.numbers<2>("peak"), r.numbers<2>("outer")};
-        p.brow_thickness = r.numbers<3>("thickness");
-        r.finish();
-    }
-    {
-        JsonReader r = top.object("hair");
-        p.hairline_y = r.number("hairline_y");
-        p.hairline_temple = r.numbers<2>("temple");
-        p.sideburn_z = r.number("sideburn_z");
-        p.sideburn_bottom_y = r.number("sideburn_bottom_y");
-        p.hair_back_bottom_y = r.number("back_bottom_y");
-        r.finish();
-    }
-    top.finish();
+        {
+            JsonReader r = top.object("eyes");
+            p.eye_centre = r.numbers<3>("centre");
+            p.eye_radius = r.number("radius");
+            p.iris_radius = r.number("iris_radius");
+            p.pupil_radius = r.number("pupil_radius");
+            p.inner_corner = r.numbers<2>("inner_corner");
+            p.outer_corner = r.numbers<2>("outer_corner");
+            p.upper_lid_height = r.number("upper_lid_height");
+            p.lower_lid_height = r.number("lower_lid_height");
+            p.upper_lid_peak = r.number("upper_lid_peak");
+            p.lower_lid_peak = r.number("lower_lid_peak");
+            p.lid_clearance = r.number("lid_clearance");
+            p.lid_thickness = r.number("lid_thickness");
+            p.lid_blend_inner = r.number("lid_blend_inner");
+            p.lid_blend_outer = r.number("lid_blend_outer");
+            p.lid_warp_reach = r.number("lid_warp_reach");
+            if (!(p.eye_radius > 0 && p.iris_radius > p.pupil_radius && p.pupil_radius > 0 &&
+                  p.iris_radius < p.eye_radius))
+                r.fail("radius > iris_radius > pupil_radius > 0",
+                       fmt::format("{} > {} > {}", p.eye_radius, p.iris_radius, p.pupil_radius));
+            if (!(p.inner_corner[0] > 0)) r.at("inner_corner").fail("x > 0 (the face's left)");
+            if (!(p.outer_corner[0] > p.inner_corner[0]))
+                r.at("outer_corner").fail(fmt::format("x > {} (further left than inner_corner)", p.inner_corner[0]));
+            r.finish();
+        }
+        {
+            JsonReader r = top.object("mouth");
+            p.mouth_y = r.number("centre_y");
+            p.mouth_half_width = r.number("half_width");
+            p.mouth_corner_rise = r.number("corner_rise");
+            p.upper_lip_height = r.number("upper_lip_height");
+            p.lower_lip_height = r.number("lower_lip_height");
+            p.cupid_dip = r.number("cupid_dip");
+            p.cupid_peak_x = r.number("cupid_peak_x");
+            p.upper_lip_protrusion = r.number("upper_lip_protrusion");
+            p.lower_lip_protrusion = r.number("lower_lip_protrusion");
+            p.lip_crease_depth = r.number("crease_depth");
+            p.lip_crease_width = r.number("crease_width");
+            p.mouth_warp_reach = r.number("warp_reach");
+            p.outer_corner_offset = r.number("outer_corner_offset");
+            for (const char* key : {"half_width", "upper_lip_height", "lower_lip_height"})
+                if (!(r.number(key) > 0)) r.at(key).fail("a positive size");
+            r.finish();
+        }
+        {
+            JsonReader r = top.object("mouth_interior");
+            p.cavity_centre = r.numbers<3>("cavity_centre");
+            p.cavity_radii = r.numbers<3>("cavity_radii");
+            p.teeth_half_width = r.number("teeth_half_width");
+            p.teeth_height = r.number("teeth_height");
+            p.teeth_depth = r.number("teeth_depth");
+            p.teeth_gap = r.number("teeth_gap");
+            p.tongue_centre = r.numbers<3>("tongue_centre");
+            p.tongue_radii = r.numbers<3>("tongue_radii");
+            r.finish();
+        }
+        for (JsonReader b : top.objects("bumps")) p.bumps.push_back(read_bump(b));
+        for (JsonReader b : top.objects("nostrils")) p.nostrils.push_back(read_bump(b));
+        for (JsonReader rr : top.objects("ridges")) {
+            Ridge ridge;
+            ridge.name = rr.string("name");
+            const JsonReader points = rr.at("points");
+            for (const JsonReader& pt : points.elements()) ridge.points.push_back(pt.as_numbers<2>());
+            if (ridge.points.size() < 2) points.fail("at least 2 points");
+            ridge.width = rr.number_list("width");
+            ridge.height = rr.number_list("height");
+            ridge.mirror = rr.boolean("mirror", false);
+            const std::string per_point = fmt::format("{} values (one per point)", ridge.points.size());
+            if (ridge.width.size() != ridge.points.size()) rr.at("width").fail(per_point);
+            if (ridge.height.size() != ridge.points.size()) rr.at("height").fail(per_point);
+            for (double w : ridge.width)
+                if (!(w > 0.0)) rr.at("width").fail("positive widths");
+            rr.finish();
+            p.ridges.push_back(std::move(ridge));
+        }
+        {
+            JsonReader r = top.object("ears");
+            p.ear_centre_yz = r.numbers<2>("centre_yz");
+            p.ear_radii_yz = r.numbers<2>("radii_yz");
+            p.ear_height = r.number("height");
+            r.finish();
+        }
+        {
+            JsonReader r = top.object("pivots");
+            p.jaw_pivot = r.numbers<3>("jaw");
+            p.head_pivot = r.numbers<3>("head");
+            r.finish();
+        }
+        {
+            JsonReader r = top.object("texture_box");
+            p.texture_box_min = r.numbers<2>("min");
+            p.texture_box_max = r.numbers<2>("max");
+            r.finish();
+        }
+        {
+            JsonReader fps = top.object("feature_points");
+            for (const auto& [id, value] : fps.entries()) {
+                const std::size_t n = value.is_array() ? value.raw().size() : 0;
+                if (n != 2 && n != 3) value.fail("[x, y] or [x, y, z]");
+                p.feature_targets[id] = value.as_number_list();
+            }
+        }
+        {
+            JsonReader r = top.object("colours");
+            p.skin = colour(r, "skin");
+            p.lips = colour(r, "lips");
+            p.brows = colour(r, "brows");
+            p.hair = colour(r, "hair");
+            p.iris = colour(r, "iris");
+            p.sclera = colour(r, "sclera");
+            p.mouth = colour(r, "mouth");
+            p.teeth = colour(r, "teeth");
+            p.tongue = colour(r, "tongue");
+            r.finish();
+        }
+        {
+            JsonReader r = top.object("brows");
+            p.brow_points = {r.numbers<2>("inner"), r.numbers<2>("peak"), r.numbers<2>("outer")};
+            p.brow_thickness = r.numbers<3>("thickness");
+            r.finish();
+        }
+        {
+            JsonReader r = top.object("hair");
+            p.hairline_y = r.number("hairline_y");
+            p.hairline_temple = r.numbers<2>("temple");
+            p.sideburn_z = r.number("sideburn_z");
+            p.sideburn_bottom_y = r.number("sideburn_bottom_y");
+            p.hair_back_bottom_y = r.number("back_bottom_y");
+            r.finish();
+        }
+    });
     return p;
 }
 

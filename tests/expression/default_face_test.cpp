@@ -209,17 +209,21 @@ TEST_F(BadFaceParams, MessagesNameTheFileAndKey) {
         std::string message;
     } cases[] = {
         {replaced("\"radius\": 12.5,", "\"radius\": 12.5, \"radiuss\": 1,"),
-         "expression: " + file + ": unknown key \"eyes.radiuss\""},
-        {replaced("\"iris_radius\": 5.9,", ""), "expression: " + file + ": missing key \"eyes.iris_radius\""},
+         "expression: " + file + ": eyes.radiuss: expected a known key (centre, radius, iris_radius, pupil_radius, "
+                                "inner_corner, outer_corner, upper_lid_height, lower_lid_height, upper_lid_peak, "
+                                "lower_lid_peak, lid_clearance, lid_thickness, lid_blend_inner, lid_blend_outer, "
+                                "lid_warp_reach), found \"radiuss\""},
+        {replaced("\"iris_radius\": 5.9,", ""), "expression: " + file + ": eyes.iris_radius: expected a value, found no such key"},
         {replaced("\"centre_y\": -66,", "\"centre_y\": \"low\","),
-         "expression: " + file + ": \"mouth.centre_y\" must be a number"},
+         "expression: " + file + ": mouth.centre_y: expected a number, found \"low\""},
         {replaced("\"texture_size\": 2048", "\"texture_size\": 9"),
-         "expression: " + file + ": texture_size must be in [16, 8192]"},
+         "expression: " + file + ": resolution.texture_size: expected an integer in [16, 8192], found 9"},
         {replaced("\"2.10\": [0, -104],", "\"2.10\": [0, -104], \"2.99\": [0, 0],"),
-         "expression: " + file + ": feature_points: \"2.99\" is not an MPEG-4 feature point"},
+         "expression: " + file + ": feature_points.\"2.99\": expected an MPEG-4 feature point id as the key, found \"2.99\""},
         {replaced("\"2.10\": [0, -104],", "\"2.10\": [0, -104], \"3.1\": [0, 0],"),
-         "expression: " + file + ": feature_points: \"3.1\" is placed by the generator; remove it"},
-        {replaced("\"2.10\": [0, -104],", ""), "expression: " + file + ": feature_points: no target for \"2.10\""},
+         "expression: " + file + ": feature_points.\"3.1\": expected a point the generator does not place, found one it "
+                                "places (remove it)"},
+        {replaced("\"2.10\": [0, -104],", ""), "expression: " + file + ": feature_points: expected a target for \"2.10\", found none"},
     };
     for (const Case& c : cases) {
         const std::string dir = write(c.text);

@@ -344,7 +344,8 @@ TEST(WrinkleSizes, RejectsSizesOutsideTheRange) {
 struct BadSpec {
     const char* name;
     const char* json;
-    const char* message;
+    const char* message;  // after "expression: <path>[:line]: "
+    int line = 0;         // of a JSON syntax error
 };
 
 class WrinkleSpecErrors : public ::testing::TestWithParam<BadSpec> {};
@@ -356,29 +357,51 @@ TEST_P(WrinkleSpecErrors, NameTheProblem) {
         load_wrinkle_spec(path);
         FAIL() << "expected an error";
     } catch (const InputError& e) {
-        EXPECT_EQ(std::string(e.what()), "expression: " + path + ": " + GetParam().message);
+        const FileLoc at{path, GetParam().line, ""};
+        EXPECT_EQ(std::string(e.what()), "expression: " + at.str() + ": " + GetParam().message);
     }
 }
 
 INSTANTIATE_TEST_SUITE_P(
     Table, WrinkleSpecErrors,
     ::testing::Values(
-        BadSpec{"no_emotions", R"({"x": 1})", "expected an object \"emotions\", found none"},
+        BadSpec{"no_emotions", R"({"emotions_": {}})", "emotions: expected a value, found no such key"},
         BadSpec{"unknown_emotion", R"({"emotions": {"boredom": []}})",
-                "unknown emotion \"boredom\" (expected neutral, joy, sadness, anger, fear, disgust or surprise)"},
+                "emotions.boredom: expected a known key (neutral, joy, sadness, anger, fear, disgust, surprise), "
+                "found \"boredom\""},
+        BadSpec{"typo_in_wrinkle", R"({"emotions": {"joy": [{"name": "a", "dpeth": 0.1, "points": [{"fp": "4.1"}]}]}})",
+                "emotions.joy[0].dpeth: expected a known key (name, profile, points, depth, width, taper, count, "
+                "step, depth_falloff, side, why), found \"dpeth\""},
+        BadSpec{"typo_at_top", R"({"emotions": {}, "neutral_skin_detial": {}})",
+                "neutral_skin_detial: expected a known key (emotions, neutral_skin_detail, about), "
+                "found \"neutral_skin_detial\""},
         BadSpec{"no_points", R"({"emotions": {"joy": [{"name": "a"}]}})",
-                "joy, wrinkle 1 (a): expected an object with a non-empty \"points\" list"},
+                "emotions.joy[0].points: expected a value, found no such key"},
+        BadSpec{"empty_points", R"({"emotions": {"joy": [{"name": "a", "points": []}]}})",
+                "emotions.joy[0].points: expected at least one point, found []"},
         BadSpec{"unknown_point", R"({"emotions": {"joy": [{"name": "a", "points": [{"fp": "12.1"}]}]}})",
-                "joy, wrinkle 1 (a): unknown feature point \"12.1\""},
+                "emotions.joy[0].points[0].fp: expected an MPEG-4 feature point id such as \"4.1\", found \"12.1\""},
         BadSpec{"bad_profile",
                 R"({"emotions": {"anger": [{"name": "b", "profile": "zigzag", "points": [{"fp": "4.1"}]}]}})",
-                "anger, wrinkle 1 (b): profile must be groove, fold, bulge or dimple, found \"zigzag\""},
+                "emotions.anger[0].profile: expected groove, fold, bulge or dimple, found \"zigzag\""},
         BadSpec{"negative_depth",
                 R"({"emotions": {"fear": [{"name": "c", "depth": -1, "points": [{"fp": "4.1"}]}]}})",
-                "fear, wrinkle 1 (c): \"depth\" must be a number in [0, 1], found -1"},
+                "emotions.fear[0].depth: expected a number in [0, 1], found -1"},
+        BadSpec{"string_depth",
+                R"({"emotions": {"fear": [{"name": "c", "depth": "deep", "points": [{"fp": "4.1"}]}]}})",
+                "emotions.fear[0].depth: expected a number in [0, 1], found \"deep\""},
+        BadSpec{"fractional_count",
+                R"({"emotions": {"fear": [{"name": "c", "count": 2.5, "points": [{"fp": "4.1"}]}]}})",
+                "emotions.fear[0].count: expected an integer in [1, 12], found 2.5"},
         BadSpec{"bad_offset",
                 R"({"emotions": {"fear": [{"name": "d", "points": [{"fp": "4.1", "offset": [1]}]}]}})",
-                "fear, wrinkle 1 (d): \"offset\" must be [x, y], found [1]"}),
+                "emotions.fear[0].points[0].offset: expected an array of 2 numbers, found [1]"},
+        BadSpec{"typo_in_point",
+                R"({"emotions": {"fear": [{"name": "d", "points": [{"fp": "4.1", "ofset": [1, 2]}]}]}})",
+                "emotions.fear[0].points[0].ofset: expected a known key (fp, offset), found \"ofset\""},
+        BadSpec{"not_json", "{\n \"emotions\": {\n  \"joy\": [,]\n }\n}",
+                "expected valid JSON, found syntax error while parsing value - unexpected ','; expected '[', '{', "
+                "or a literal", 3}),
     [](const auto& info) { return std::string(info.param.name); });
 
 TEST(FeatureLines, TheShippedSetCoversTheFaceWithUsableLines) {
