@@ -34,7 +34,7 @@ bool parse_number(std::string_view s, double* out) {
 }
 
 constexpr const char* kExpected =
-    "expected joy (or happiness), sadness, anger, fear, disgust, surprise or neutral";
+    "expected joy (or happiness), sadness, anger, fear, disgust, surprise, neutral or an action unit (AU4, AU12L)";
 
 }  // namespace
 
@@ -72,10 +72,11 @@ std::string EmotionMix::to_string() const {
         if (!out.empty()) out += " + ";
         out += fmt::format("{:g} {}", w, emotion_name(e));
     }
+    if (!aus.empty()) out += (out.empty() ? "" : " + ") + aus.to_string();
     return out.empty() ? "neutral" : out;
 }
 
-bool operator==(const EmotionMix& a, const EmotionMix& b) { return a.weights == b.weights; }
+bool operator==(const EmotionMix& a, const EmotionMix& b) { return a.weights == b.weights && a.aus == b.aus; }
 bool operator!=(const EmotionMix& a, const EmotionMix& b) { return !(a == b); }
 
 EmotionMix parse_emotion_mix(std::string_view text, bool normalise) {
@@ -99,6 +100,7 @@ EmotionMix parse_emotion_mix(std::string_view text, bool normalise) {
     EmotionMix mix;
     double neutral = 0.0;
     std::array<int, kEmotionCount + 1> given_in{};  // part number (1-based) per emotion, [6] = neutral
+    std::array<int, kAuNumberLimit> au_left_in{}, au_right_in{};  // part number per AU side
     for (std::size_t k = 0; k < parts.size(); ++k) {
         const std::string_view part = trim(parts[k]);
         const int number = static_cast<int>(k) + 1;
@@ -126,11 +128,30 @@ EmotionMix parse_emotion_mix(std::string_view text, bool normalise) {
             if (eq == std::string_view::npos && is_number_start(name)) bad(where + ": expected \"weight name\", the name comes last");
             bad(fmt::format("{}: \"{}\" is not a number", where, weight));
         }
+        std::string au_error;
+        const auto au = parse_au_term(name, &au_error);
+        if (!au_error.empty()) bad(fmt::format("{}: {}", where, au_error));
         const bool is_neutral = lower(name) == "neutral";
         const auto e = find_emotion(name);
-        if (!e && !is_neutral) bad(fmt::format("unknown emotion \"{}\" in {}; {}", name, where, kExpected));
+        if (!e && !is_neutral && !au) bad(fmt::format("unknown emotion \"{}\" in {}; {}", name, where, kExpected));
         if (w < 0) bad(fmt::format("{}: weight {:g} is negative; weights are in [0, 1]", where, w));
         if (w > 1) bad(fmt::format("{}: weight {:g} is above 1; weights are in [0, 1]", where, w));
+        if (au) {
+            const bool left = au->side != AuSide::Right, right = au->side != AuSide::Left;
+            const int before = left && au_left_in[au->number] ? au_left_in[au->number]
+                                                              : (right ? au_right_in[au->number] : 0);
+            if (before != 0)
+                bad(fmt::format("AU{} is given twice (parts {} and {})", au->number, before, number));
+            if (left) {
+                au_left_in[au->number] = number;
+                mix.aus.left[au->number] = w;
+            }
+            if (right) {
+                au_right_in[au->number] = number;
+                mix.aus.right[au->number] = w;
+            }
+            continue;
+        }
         const int slot = is_neutral ? kEmotionCount : emotion_index(*e);
         if (given_in[slot] != 0)
             bad(fmt::format("\"{}\" is given twice (parts {} and {})", is_neutral ? "neutral" : emotion_name(*e),

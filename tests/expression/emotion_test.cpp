@@ -48,7 +48,7 @@ TEST(EmotionMix, AcceptsBothNotationsAndHappiness) {
 
 TEST(EmotionMix, RejectsWithMessagesThatNameThePart) {
     const std::string expected_names =
-        "expected joy (or happiness), sadness, anger, fear, disgust, surprise or neutral";
+        "expected joy (or happiness), sadness, anger, fear, disgust, surprise, neutral or an action unit (AU4, AU12L)";
     struct Case {
         const char* text;
         std::string message;
@@ -82,6 +82,64 @@ TEST(EmotionMix, RejectsWithMessagesThatNameThePart) {
         {"0.3 0.4 fear", "expression: emotion mix \"0.3 0.4 fear\": part 1 (\"0.3 0.4 fear\"): expected "
                          "\"name=weight\", \"weight name\" or \"name\""},
         {"anger=nan", "expression: emotion mix \"anger=nan\": part 1 (\"anger=nan\"): \"nan\" is not a number"},
+    };
+    for (const Case& c : cases) {
+        try {
+            parse_emotion_mix(c.text);
+            ADD_FAILURE() << "accepted \"" << c.text << "\"";
+        } catch (const InputError& e) {
+            EXPECT_EQ(std::string(e.what()), c.message);
+        }
+    }
+}
+
+TEST(EmotionMix, AcceptsActionUnitsBesideEmotions) {
+    struct Case {
+        const char* text;
+        Emotion emotion;  // weight below; Joy with 0 for none
+        double weight;
+        int au;
+        double left, right;
+    } cases[] = {
+        {"0.6 joy + 0.3 AU4", Emotion::Joy, 0.6, 4, 0.3, 0.3},
+        {"AU1+AU2", Emotion::Joy, 0.0, 1, 1.0, 1.0},
+        {"AU1+AU2", Emotion::Joy, 0.0, 2, 1.0, 1.0},
+        {"AU12L", Emotion::Joy, 0.0, 12, 1.0, 0.0},
+        {"au12r=0.5", Emotion::Joy, 0.0, 12, 0.0, 0.5},
+        {"0.2 AU12L + 0.7 AU12R, anger=0.4", Emotion::Anger, 0.4, 12, 0.2, 0.7},
+        {"1 joy + 1 AU4", Emotion::Joy, 1.0, 4, 1.0, 1.0},  // AUs do not count in the sum
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.text);
+        const EmotionMix m = parse_emotion_mix(c.text);
+        EXPECT_NEAR(m[c.emotion], c.weight, 1e-12);
+        EXPECT_NEAR(m.aus.left[c.au], c.left, 1e-12);
+        EXPECT_NEAR(m.aus.right[c.au], c.right, 1e-12);
+        EXPECT_EQ(parse_emotion_mix(m.to_string()), m) << m.to_string();
+    }
+    EXPECT_EQ(parse_emotion_mix("0.6 joy + 0.3 AU4").to_string(), "0.6 joy + 0.3 AU4");
+    EXPECT_EQ(parse_emotion_mix("AU12L + 0.5 AU12R").to_string(), "1 AU12L + 0.5 AU12R");
+    // Normalising divides the emotions only.
+    const EmotionMix n = parse_emotion_mix("0.8 joy + 0.8 anger + 0.5 AU4", true);
+    EXPECT_NEAR(n[Emotion::Joy], 0.5, 1e-12);
+    EXPECT_NEAR(n.aus.left[4], 0.5, 1e-12);
+}
+
+TEST(EmotionMix, RejectsBadActionUnits) {
+    struct Case {
+        const char* text;
+        std::string message;
+    } cases[] = {
+        {"AU12X", "expression: emotion mix \"AU12X\": part 1 (\"AU12X\"): \"AU12X\" is not an action unit; expected "
+                  "AU<number>, AU<number>L or AU<number>R (e.g. AU12, AU12L)"},
+        {"0.3 AU", "expression: emotion mix \"0.3 AU\": part 1 (\"0.3 AU\"): \"AU\" is not an action unit; expected "
+                   "AU<number>, AU<number>L or AU<number>R (e.g. AU12, AU12L)"},
+        {"AU0", "expression: emotion mix \"AU0\": part 1 (\"AU0\"): \"AU0\": action units are numbered 1..64"},
+        {"AU99L", "expression: emotion mix \"AU99L\": part 1 (\"AU99L\"): \"AU99L\": action units are numbered 1..64"},
+        {"AU12 + 0.5 AU12L", "expression: emotion mix \"AU12 + 0.5 AU12L\": AU12 is given twice (parts 1 and 2)"},
+        {"AU12R + AU12", "expression: emotion mix \"AU12R + AU12\": AU12 is given twice (parts 1 and 2)"},
+        {"1.5 AU4", "expression: emotion mix \"1.5 AU4\": part 1 (\"1.5 AU4\"): weight 1.5 is above 1; weights are "
+                    "in [0, 1]"},
     };
     for (const Case& c : cases) {
         try {
@@ -165,8 +223,10 @@ TEST(Profiles, BadFilesNameTheEntry) {
     const auto dir = std::filesystem::temp_directory_path() / "emoface_profiles_test";
     std::filesystem::create_directories(dir);
     const std::string path = (dir / "emotions.json").string();
-    auto write_and_load = [&](const std::string& text) {
-        std::ofstream(path) << text;
+    const std::string aus_path = (dir / "action_units.json").string();
+    std::filesystem::copy_file(std::string(EMOFACE_DATA_DIR) + "/expression/action_units.json", aus_path,
+                               std::filesystem::copy_options::overwrite_existing);
+    auto load = [&]() {
         try {
             load_emotion_profiles(path);
         } catch (const InputError& e) {
@@ -175,23 +235,75 @@ TEST(Profiles, BadFilesNameTheEntry) {
         return std::string("(no error)");
     };
     const std::string five =
-        R"("joy": {"reasoning": "r", "faps": {}}, "sadness": {"reasoning": "r", "faps": {}},
-           "anger": {"reasoning": "r", "faps": {}}, "fear": {"reasoning": "r", "faps": {}},
-           "disgust": {"reasoning": "r", "faps": {}})";
-    EXPECT_EQ(write_and_load("{\"emotions\": {" + five + "}}"),
-              "expression: " + path + ": missing key \"emotions.surprise\"");
-    EXPECT_EQ(write_and_load("{\"emotions\": {" + five + R"(, "surprise": {"reasoning": "r", "faps": {"open_jaws": 3}}}})"),
-              "expression: " + path + ": emotions.surprise.faps: \"open_jaws\" is not a FAP name or number");
-    EXPECT_EQ(write_and_load("{\"emotions\": {" + five + R"(, "surprise": {"reasoning": "r", "faps": {"2": 3}}}})"),
-              "expression: " + path + ": emotions.surprise.faps: FAP 2 (expression) is not allowed here; expected a "
-                                      "low-level FAP (3..68)");
-    EXPECT_EQ(write_and_load("{\"emotions\": {" + five + R"(, "surprise": {"reasoning": "r", "faps": {"3": "x"}}}})"),
-              "expression: " + path + ": emotions.surprise.faps: the value of \"3\" must be a number");
-    EXPECT_EQ(write_and_load("{\"emotions\": {" + five +
-                             R"(, "surprise": {"reasoning": "r", "faps": {"3": 1, "open_jaw": 2}}}})"),
-              "expression: " + path + ": emotions.surprise.faps: FAP 3 is given twice");
-    EXPECT_EQ(write_and_load("{\"emotions\": {" + five + R"(, "surprise": {"reasoning": "r", "faps": {}, "x": 1}}})"),
-              "expression: " + path + ": unknown key \"emotions.surprise.x\"");
+        R"("action_units": "action_units.json", "emotions": {
+           "joy": {"reasoning": "r", "action_units": {"AU12": 1}}, "sadness": {"reasoning": "r", "action_units": {}},
+           "anger": {"reasoning": "r", "action_units": {}}, "fear": {"reasoning": "r", "action_units": {}},
+           "disgust": {"reasoning": "r", "action_units": {}})";
+    struct Case {
+        const char* what;
+        std::string emotions;  // emotions.json
+        std::string message;   // after "expression: <path>: "
+    } cases[] = {
+        {"no surprise", "{" + five + "}}", "emotions.surprise: expected a value, found no such key"},
+        {"unknown AU", "{" + five + R"(, "surprise": {"reasoning": "r", "action_units": {"AU30": 1}}}})",
+         "emotions.surprise.action_units.AU30: expected an AU of action_units.json (1, 2, 4, 5, 6, 7, 9, 10, 11, 12, "
+         "13, 14, 15, 16, 17, 18, 20, 22, 23, 24, 25, 26, 27, 28, 29, 41, 43, 45, 46, 51, 52, 53, 54, 55, 56, 57, 58, "
+         "61, 62, 63, 64), found \"AU30\""},
+        {"AU with a side", "{" + five + R"(, "surprise": {"reasoning": "r", "action_units": {"AU1L": 1}}}})",
+         "emotions.surprise.action_units.AU1L: expected a whole action unit \"AU<number>\" as the key, found \"AU1L\""},
+        {"intensity", "{" + five + R"(, "surprise": {"reasoning": "r", "action_units": {"AU1": 1.5}}}})",
+         "emotions.surprise.action_units.AU1: expected an intensity in (0, 1], found 1.5"},
+        {"unknown key", "{" + five + R"(, "surprise": {"reasoning": "r", "action_units": {}, "faps": {}}}})",
+         "emotions.surprise.faps: expected a known key (reasoning, action_units), found \"faps\""},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.what);
+        std::ofstream(path) << c.emotions;
+        EXPECT_EQ(load(), "expression: " + path + ": " + c.message);
+    }
+    std::filesystem::remove_all(dir);
+}
+
+TEST(ActionUnitTable, BadEntriesNameTheKey) {
+    const auto dir = std::filesystem::temp_directory_path() / "emoface_action_units_test";
+    std::filesystem::create_directories(dir);
+    const std::string path = (dir / "action_units.json").string();
+    const std::string regions =
+        R"("regions": [{"name": "brows", "faps": [31, 32, 33, 34, 35, 36, 37, 38]}, {"name": "mouth", "faps": [59, 60]}])";
+    auto au = [](const std::string& body) {
+        return R"(, "action_units": {"AU1": {"name": "n", "muscle": "m", "reasoning": "r", )" + body + "}}}";
+    };
+    struct Case {
+        const char* what;
+        std::string text;
+        std::string message;  // after "expression: <path>: "
+    } cases[] = {
+        {"asymmetric", "{" + regions + au(R"("region": "brows", "sides": true, "faps": {"31": 100, "32": 90})"),
+         "action_units.AU1.faps: expected left-right symmetric values (a bilateral AU's halves mirror each other), "
+         "found FAP 31 (raise_l_i_eyebrow) 100 but FAP 32 (raise_r_i_eyebrow) 90"},
+        {"earlier region", "{" + regions + au(R"("region": "mouth", "sides": false, "faps": {"31": 100, "59": 10})"),
+         "action_units.AU1.faps: expected FAPs of region \"mouth\" or of regions fitted after it, found FAP 31 "
+         "(raise_l_i_eyebrow) of region \"brows\", fitted before"},
+        {"unknown region", "{" + regions + au(R"("region": "ears", "sides": false, "faps": {})"),
+         "action_units.AU1.region: expected the name of one of \"regions\", found \"ears\""},
+        {"bad FAP", "{" + regions + au(R"("region": "brows", "sides": false, "faps": {"2": 1})"),
+         "action_units.AU1.faps.2: expected a low-level FAP (3..68), found FAP 2 (expression)"},
+        {"FAP in two regions",
+         R"({"regions": [{"name": "a", "faps": [31]}, {"name": "b", "faps": [31]}], "action_units": {}})",
+         "regions[1].faps: expected each FAP in one region, found FAP 31 also in \"a\""},
+        {"bad AU key", "{" + regions + R"(, "action_units": {"AU12X": {}}})",
+         "action_units.AU12X: expected an action unit key \"AU<number>\", found \"AU12X\""},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.what);
+        std::ofstream(path) << c.text;
+        try {
+            load_action_units(path);
+            ADD_FAILURE() << "accepted";
+        } catch (const InputError& e) {
+            EXPECT_EQ(std::string(e.what()), "expression: " + path + ": " + c.message);
+        }
+    }
     std::filesystem::remove_all(dir);
 }
 

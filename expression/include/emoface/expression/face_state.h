@@ -1,7 +1,7 @@
 #pragma once
 // What a face shows in one frame (DESIGN.md, "One frame"): its low-level
-// FAPs (which drive the rig), its emotion mixture (which drives the
-// wrinkles) and its viseme.
+// FAPs (which drive the rig), its FACS Action Units per side, its emotion
+// mixture (which drives the wrinkles) and its viseme.
 #include <bitset>
 
 #include "emoface/expression/emotion.h"
@@ -14,15 +14,16 @@ namespace emoface::expression {
 enum class MixSource {
     None,        // no emotion: neutral
     Expression,  // from FAP 2 (intensity / 63 of each selected emotion)
-    Fitted,      // inferred from the low-level FAPs (non-negative least squares)
-    Given,       // set by the caller (face_state(const EmotionMix&, ...))
+    FromActionUnits,  // derived from the frame's AUs (EmotionProfiles::mix_from_action_units)
+    Given,            // set by the caller (face_state(const EmotionMix&, ...))
 };
 const char* mix_source_name(MixSource s);
 
 struct FaceState {
     FapValues faps{};               // low-level FAPs 3..68 for the rig
     std::bitset<fap::kFapCount> mask;  // which of them the frame gave or were synthesised
-    EmotionMix mix;
+    AuIntensities aus;              // the FACS Action Units the face shows, per side
+    EmotionMix mix;                 // emotion weights only (its `aus` stay empty)
     MixSource mix_source = MixSource::None;
     bool has_viseme = false;
     fap::Viseme viseme;
@@ -31,25 +32,27 @@ struct FaceState {
 // The state of one frame; pass frames resolved for untransmitted FAPs
 // (fap::FapStream::resolved / sample) so the mask holds every FAP in effect.
 //  - faps: the frame's transmitted low-level values;
+//  - aus: inferred from the low-level FAPs, region by region and side by side
+//    (ActionUnitTable::infer), when the frame has any; otherwise the AUs of
+//    the mix from FAP 2;
 //  - mix: from FAP 2 when transmitted (select1 at intensity1 / 63, select2 at
 //    intensity2 / 63, summed if both name one emotion, scaled down if they
-//    sum over 1); otherwise the NNLS fit of the low-level FAPs onto the six
-//    profiles (fit_emotion_mix), if there are any;
+//    sum over 1); otherwise derived from the inferred AUs
+//    (EmotionProfiles::mix_from_action_units), if there are any;
 //  - a frame with FAP 2 and no low-level FAPs gets them synthesised from the
-//    mix's profiles, so the mesh moves too;
+//    mix's AUs, so the mesh moves too;
 //  - with `visemes`, a frame with FAP 1 and no mouth FAPs of its own gets the
 //    viseme's mouth FAPs added.
 FaceState face_state(const fap::FapFrame& frame, const EmotionProfiles& emotions,
                      const VisemeProfiles* visemes = nullptr);
 
-// The state that shows `mix`: its profiles' FAPs (every FAP any profile sets
-// in the mask).
+// The state that shows `mix`: aus = its emotions' prototypes plus its own
+// AUs (EmotionProfiles::action_units_of), faps = their FAPs (the mask: every
+// FAP an emotion profile or the state's AUs set). mix: the given emotion
+// weights (MixSource::Given); for a mix with AUs of its own, derived from
+// all its AUs (MixSource::FromActionUnits), so "AU1+AU2" drives the
+// wrinkles as a surprise does. Throws emoface::InputError for an AU the
+// table lacks.
 FaceState face_state(const EmotionMix& mix, const EmotionProfiles& emotions);
-
-// The mix whose profiles best explain `faps` over the FAPs in `mask` that
-// some profile sets: min |A w - b| with w >= 0 (Lawson-Hanson NNLS), scaled
-// down to sum 1 if it sums over 1. Empty overlap: neutral.
-EmotionMix fit_emotion_mix(const FapValues& faps, const std::bitset<fap::kFapCount>& mask,
-                           const EmotionProfiles& emotions);
 
 }  // namespace emoface::expression
