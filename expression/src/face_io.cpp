@@ -7,6 +7,7 @@
 #include <cstring>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -14,6 +15,7 @@
 
 #include "emoface/common/error.h"
 #include "emoface/fap/feature_points.h"
+#include "json_reader.h"
 
 namespace emoface::expression {
 namespace {
@@ -114,21 +116,9 @@ void finish_mesh(Face& face) {
 
 json vec_json(const Vec3d& v) { return json::array({v[0], v[1], v[2]}); }
 
-Vec3d vec_from(const json& j, const std::string& file, const std::string& what) {
-    if (!j.is_array() || j.size() != 3 || !j[0].is_number() || !j[1].is_number() || !j[2].is_number())
-        fail<InputError>("expression: {}: \"{}\" must be [x, y, z]", file, what);
-    Vec3d v{j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
-    for (double c : v)
-        if (!std::isfinite(c)) fail<InputError>("expression: {}: \"{}\" is not finite", file, what);
-    return v;
-}
-
-int int_from(const json& j, const std::string& file, const std::string& what, int limit) {
-    if (!j.is_number_integer()) fail<InputError>("expression: {}: \"{}\" must be an integer", file, what);
-    const long long v = j.get<long long>();
-    if (v < 0 || v >= limit)
-        fail<InputError>("expression: {}: \"{}\" is {}, expected a vertex index in [0, {})", file, what, v, limit);
-    return static_cast<int>(v);
+Vec3d vec_from(const detail::JsonReader& value) {
+    const auto xyz = value.as_numbers<3>();
+    return {xyz[0], xyz[1], xyz[2]};
 }
 
 // Makes x point to the face's left and z to the viewer, judging by pairs of
@@ -379,100 +369,99 @@ Face load_obj_with_fdp(const std::string& obj_path, const std::string& fdp_path)
     face.parts.assign(face.mesh.n_vertices(), VertexPart::Skin);
     const int obj_vertices = static_cast<int>(positions.size());
 
-    json j;
-    try {
-        j = json::parse(read_text(fdp_path));
-    } catch (const json::parse_error& e) {
-        fail<InputError>("expression: {}: not valid JSON (at byte {})", fdp_path, e.byte);
-    }
-    if (!j.is_object() || !j.contains("feature_points") || !j["feature_points"].is_object())
-        fail<InputError>("expression: {}: expected an object with \"feature_points\"", fdp_path);
-    if (j.contains("name") && j["name"].is_string()) face.name = j["name"].get<std::string>();
-    for (auto it = j["feature_points"].begin(); it != j["feature_points"].end(); ++it) {
-        if (!it.key().empty() && it.key()[0] == '_') continue;
-        const auto k = fap::find_feature_point(it.key());
-        if (!k) fail<InputError>("expression: {}: \"{}\" is not an MPEG-4 feature point", fdp_path, it.key());
-        const json& e = *it;
-        FeaturePointLocation& fp = face.feature_points[*k];
-        fp.present = true;
-        if (e.is_object() && e.contains("vertex")) {
-            fp.vertex = int_from(e["vertex"], fdp_path, "feature_points." + it.key() + ".vertex", obj_vertices);
-            const auto q = face.mesh.point(TriMesh::VertexHandle(fp.vertex));
-            fp.position = {q[0], q[1], q[2]};
-        } else if (e.is_object() && e.contains("position")) {
-            fp.position = vec_from(e["position"], fdp_path, "feature_points." + it.key() + ".position");
-        } else {
-            fail<InputError>("expression: {}: feature_points.\"{}\" must be {{\"vertex\": i}} or {{\"position\": [x, y, z]}}",
-                             fdp_path, it.key());
-        }
-    }
-    const int n = face.vertex_count();
-    if (j.contains("parts")) {
-        if (!j["parts"].is_array()) fail<InputError>("expression: {}: \"parts\" must be an array", fdp_path);
-        for (const json& p : j["parts"]) {
-            if (!p.is_object() || !p.contains("part") || !p["part"].is_string())
-                fail<InputError>("expression: {}: each of \"parts\" needs \"part\", \"first\", \"count\"", fdp_path);
-            const std::string name = p["part"].get<std::string>();
-            int part = -1;
-            for (int q = 0; q <= static_cast<int>(VertexPart::Tongue); ++q)
-                if (name == part_name(static_cast<VertexPart>(q))) part = q;
-            if (part < 0) fail<InputError>("expression: {}: unknown part \"{}\"", fdp_path, name);
-            const int first = int_from(p.value("first", json()), fdp_path, "parts.first", n);
-            const int count = int_from(p.value("count", json()), fdp_path, "parts.count", n + 1);
-            if (first + count > n) fail<InputError>("expression: {}: part \"{}\" runs past the mesh's {} vertices", fdp_path, name, n);
-            for (int v = first; v < first + count; ++v) face.parts[v] = static_cast<VertexPart>(part);
-        }
-    }
-    if (j.contains("eyeballs")) {
-        if (!j["eyeballs"].is_array()) fail<InputError>("expression: {}: \"eyeballs\" must be an array", fdp_path);
-        for (const json& e : j["eyeballs"]) {
-            Eyeball eb;
-            if (!e.is_object() || !e.contains("vertices") || !e["vertices"].is_array() || e["vertices"].size() != 2)
-                fail<InputError>("expression: {}: an eyeball needs \"vertices\": [first, count]", fdp_path);
-            eb.vertices.first = int_from(e["vertices"][0], fdp_path, "eyeballs.vertices[0]", n);
-            eb.vertices.count = int_from(e["vertices"][1], fdp_path, "eyeballs.vertices[1]", n + 1);
-            eb.centre = vec_from(e.value("centre", json()), fdp_path, "eyeballs.centre");
-            if (!e.contains("radius") || !e["radius"].is_number())
-                fail<InputError>("expression: {}: an eyeball needs a \"radius\"", fdp_path);
-            eb.radius = e["radius"].get<double>();
-            eb.iris_angle = e.value("iris_angle", 0.5);
-            eb.pupil_angle = e.value("pupil_angle", 0.18);
-            for (const char* key : {"upper_margin", "lower_margin"}) {
-                if (!e.contains(key)) continue;
-                if (!e[key].is_array()) fail<InputError>("expression: {}: eyeballs.{} must be an array", fdp_path, key);
-                auto& margin = std::string(key) == "upper_margin" ? eb.upper_margin : eb.lower_margin;
-                for (const json& v : e[key]) margin.push_back(int_from(v, fdp_path, std::string("eyeballs.") + key, n));
+    // Pivots and texture box given in the file replace the estimated ones.
+    std::optional<Vec3d> jaw_pivot, head_pivot;
+    std::optional<TextureBox> texture_box;
+    detail::read_json_file(fdp_path, [&](detail::JsonReader& root) {
+        // Written by save_fdp; free text for people.
+        root.comment("frame");
+        if (root.has("format") && root.string("format") != "emoface-fdp")
+            root.at("format").fail("\"emoface-fdp\"");
+        if (root.has("version")) root.integer_in("version", 1, 1);
+        if (root.has("mesh")) (void)root.string("mesh");
+        if (root.has("name")) face.name = root.string("name");
+        for (auto& [id, entry] : root.object("feature_points").entries()) {
+            const auto k = fap::find_feature_point(id);
+            if (!k) entry.fail("an MPEG-4 feature point id as the key", "\"" + id + "\"");
+            const char* expected = "{\"vertex\": i} or {\"position\": [x, y, z]}";
+            if (!entry.is_object()) entry.fail(expected);
+            detail::JsonReader e = entry.as_object();
+            FeaturePointLocation& fp = face.feature_points[*k];
+            fp.present = true;
+            const bool by_vertex = e.has("vertex"), by_position = e.has("position");
+            if (by_vertex == by_position) e.fail(expected);
+            if (by_vertex) {
+                fp.vertex = e.integer_in("vertex", 0, obj_vertices - 1);
+                const auto q = face.mesh.point(TriMesh::VertexHandle(fp.vertex));
+                fp.position = {q[0], q[1], q[2]};
+            } else {
+                fp.position = vec_from(e.at("position"));
             }
-            face.eyeballs.push_back(std::move(eb));
+            e.finish();
         }
-    }
-    if (j.contains("welded")) {
-        if (!j["welded"].is_array()) fail<InputError>("expression: {}: \"welded\" must be an array", fdp_path);
-        for (const json& w : j["welded"]) {
-            if (!w.is_array() || w.size() != 2) fail<InputError>("expression: {}: welded entries are [a, b]", fdp_path);
-            face.welded.push_back({int_from(w[0], fdp_path, "welded", n), int_from(w[1], fdp_path, "welded", n)});
+        const int n = face.vertex_count();
+        if (root.has("parts")) {
+            for (detail::JsonReader p : root.objects("parts")) {
+                const detail::JsonReader name = p.at("part");
+                int part = -1;
+                for (int q = 0; q <= static_cast<int>(VertexPart::Tongue); ++q)
+                    if (name.as_string() == part_name(static_cast<VertexPart>(q))) part = q;
+                if (part < 0) name.fail("skin, eyeball_left, eyeball_right, mouth_upper, mouth_lower or tongue");
+                const int first = p.integer_in("first", 0, n - 1);
+                const int count = p.integer_in("count", 0, n - first);
+                p.finish();
+                for (int v = first; v < first + count; ++v) face.parts[v] = static_cast<VertexPart>(part);
+            }
         }
-    }
+        if (root.has("eyeballs")) {
+            for (detail::JsonReader e : root.objects("eyeballs")) {
+                Eyeball eb;
+                if (e.has("side")) (void)e.string("side");  // informative; the centre decides
+                const detail::JsonReader range = e.at("vertices");
+                const std::vector<detail::JsonReader> ends = range.elements();
+                if (ends.size() != 2) range.fail("[first, count]");
+                eb.vertices.first = ends[0].as_integer_in(0, n - 1);
+                eb.vertices.count = ends[1].as_integer_in(0, n - eb.vertices.first);
+                eb.centre = vec_from(e.at("centre"));
+                eb.radius = e.number("radius");
+                eb.iris_angle = e.number("iris_angle", 0.5);
+                eb.pupil_angle = e.number("pupil_angle", 0.18);
+                for (const char* key : {"upper_margin", "lower_margin"}) {
+                    if (!e.has(key)) continue;
+                    auto& margin = std::string(key) == "upper_margin" ? eb.upper_margin : eb.lower_margin;
+                    for (const detail::JsonReader& v : e.at(key).elements()) margin.push_back(v.as_integer_in(0, n - 1));
+                }
+                e.finish();
+                face.eyeballs.push_back(std::move(eb));
+            }
+        }
+        if (root.has("welded")) {
+            for (const detail::JsonReader& w : root.at("welded").elements()) {
+                const std::vector<detail::JsonReader> pair = w.elements();
+                if (pair.size() != 2) w.fail("a pair [a, b] of vertex indices");
+                face.welded.push_back({pair[0].as_integer_in(0, n - 1), pair[1].as_integer_in(0, n - 1)});
+            }
+        }
+        if (root.has("jaw_pivot")) jaw_pivot = vec_from(root.at("jaw_pivot"));
+        if (root.has("head_pivot")) head_pivot = vec_from(root.at("head_pivot"));
+        if (root.has("texture_box")) {
+            detail::JsonReader b = root.object("texture_box");
+            const auto min = b.numbers<2>("min");
+            const auto max = b.numbers<2>("max");
+            b.finish();
+            texture_box = TextureBox{{static_cast<float>(min[0]), static_cast<float>(min[1])},
+                                     {static_cast<float>(max[0]), static_cast<float>(max[1])}};
+            if (!(texture_box->max.x > texture_box->min.x && texture_box->max.y > texture_box->min.y))
+                b.at("max").fail(fmt::format("a corner above and right of min [{}, {}]", min[0], min[1]));
+        }
+        if (root.has("base_colour")) face.base_colour_file = folder_of(fdp_path) + root.string("base_colour");
+    });
     finish_mesh(face);
     update_fapu(face);
     estimate_pivots(face);
-    if (j.contains("jaw_pivot")) face.jaw_pivot = vec_from(j["jaw_pivot"], fdp_path, "jaw_pivot");
-    if (j.contains("head_pivot")) face.head_pivot = vec_from(j["head_pivot"], fdp_path, "head_pivot");
-    face.texture_box = frontal_box(face);
-    if (j.contains("texture_box")) {
-        const json& b = j["texture_box"];
-        if (!b.is_object() || !b.contains("min") || !b.contains("max") || !b["min"].is_array() || !b["max"].is_array() ||
-            b["min"].size() != 2 || b["max"].size() != 2)
-            fail<InputError>("expression: {}: \"texture_box\" must be {{\"min\": [x, y], \"max\": [x, y]}}", fdp_path);
-        for (const json& c : {b["min"][0], b["min"][1], b["max"][0], b["max"][1]})
-            if (!c.is_number()) fail<InputError>("expression: {}: texture_box corners must be numbers", fdp_path);
-        face.texture_box.min = {b["min"][0].get<float>(), b["min"][1].get<float>()};
-        face.texture_box.max = {b["max"][0].get<float>(), b["max"][1].get<float>()};
-        if (!(face.texture_box.max.x > face.texture_box.min.x && face.texture_box.max.y > face.texture_box.min.y))
-            fail<InputError>("expression: {}: texture_box max must exceed min", fdp_path);
-    }
-    if (j.contains("base_colour") && j["base_colour"].is_string())
-        face.base_colour_file = folder_of(fdp_path) + j["base_colour"].get<std::string>();
+    if (jaw_pivot) face.jaw_pivot = *jaw_pivot;
+    if (head_pivot) face.head_pivot = *head_pivot;
+    face.texture_box = texture_box ? *texture_box : frontal_box(face);
     validate_face(face, fdp_path);
     return face;
 }

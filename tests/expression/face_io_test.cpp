@@ -162,14 +162,30 @@ TEST_F(FaceFiles, ReadersNameTheFileLineAndProblem) {
         std::string fdp;
         std::string message;
     } fdps[] = {
-        {"{", ": not valid JSON (at byte 2)"},
-        {"{}", ": expected an object with \"feature_points\""},
-        {R"({"feature_points": {"12.1": {"vertex": 0}}})", ": \"12.1\" is not an MPEG-4 feature point"},
+        {"{", ":1: expected valid JSON, found syntax error while parsing object key - unexpected end of input; "
+              "expected string literal"},
+        {"{}", ": feature_points: expected a value, found no such key"},
+        {R"({"feature_points": {"12.1": {"vertex": 0}}})",
+         ": feature_points.\"12.1\": expected an MPEG-4 feature point id as the key, found \"12.1\""},
         {R"({"feature_points": {"2.1": {"vertex": 99}}})",
-         ": \"feature_points.2.1.vertex\" is 99, expected a vertex index in [0, 16)"},
-        {R"({"feature_points": {"2.1": {"vertex": 1.5}}})", ": \"feature_points.2.1.vertex\" must be an integer"},
-        {R"({"feature_points": {"2.1": {"position": [1, 2]}}})", ": \"feature_points.2.1.position\" must be [x, y, z]"},
-        {R"({"feature_points": {"2.1": 3}})", ": feature_points.\"2.1\" must be {\"vertex\": i} or {\"position\": [x, y, z]}"},
+         ": feature_points.\"2.1\".vertex: expected an integer in [0, 15], found 99"},
+        {R"({"feature_points": {"2.1": {"vertex": 1.5}}})",
+         ": feature_points.\"2.1\".vertex: expected an integer in [0, 15], found 1.5"},
+        {R"({"feature_points": {"2.1": {"position": [1, 2]}}})",
+         ": feature_points.\"2.1\".position: expected an array of 3 numbers, found [1,2]"},
+        {R"({"feature_points": {"2.1": 3}})",
+         ": feature_points.\"2.1\": expected {\"vertex\": i} or {\"position\": [x, y, z]}, found 3"},
+        // Typos: a misspelt key is an error, not a key quietly ignored.
+        {R"({"feature_points": {"2.1": {"vertx": 3}}})",
+         ": feature_points.\"2.1\": expected {\"vertex\": i} or {\"position\": [x, y, z]}, found {\"vertx\":3}"},
+        {R"({"feature_points": {"2.1": {"vertex": 3, "postion": [1, 2, 3]}}})",
+         ": feature_points.\"2.1\".postion: expected a known key (vertex, position), found \"postion\""},
+        {R"({"feature_points": {}, "jaw_pivto": [0, 0, 0]})",
+         ": jaw_pivto: expected a known key (format, version, mesh, name, feature_points, parts, eyeballs, "
+         "welded, jaw_pivot, head_pivot, texture_box, base_colour, frame), found \"jaw_pivto\""},
+        {R"({"feature_points": {}, "parts": [{"part": "lips", "first": 0, "count": 1}]})",
+         ": parts[0].part: expected skin, eyeball_left, eyeball_right, mouth_upper, mouth_lower or tongue, "
+         "found \"lips\""},
     };
     for (const auto& c : fdps) {
         const std::string f = write("bad.fdp.json", c.fdp);
