@@ -16,11 +16,11 @@
 #include <memory>
 #include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "bench_inputs.h"
 #include "emoface/common/error.h"
+#include "emoface/common/parallel.h"
 #include "emoface/morph/morph.h"
 
 #if defined(EMOFACE_BENCH_CUDA)
@@ -126,8 +126,8 @@ public:
     std::string report(const std::string& command) const {
         std::ostringstream s;
         s << "command: `" << command << "`\n\n";
-        s << "device: " << morph::cuda_device_description() << "; host threads: "
-          << std::max(1u, std::thread::hardware_concurrency()) << "\n\n";
+        s << "device: " << morph::cuda_device_description() << "; host threads: " << parallel_threads()
+          << "; CPU row loops: " << morph::cpu_kernels_name() << "\n\n";
         s << "| size | N | K | backend | ms/frame | single frame ms | graph ms/frame | host µs/frame | CPU ms/frame | "
              "batch | runs | G px-lines/s | x thesis | fast max err px | fast p99.9 err px |\n";
         s << "|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";

@@ -30,14 +30,26 @@ __global__ void make_interpolation(const float* lines, const float* weights, int
     target[i] = sum;
 }
 
-// MakeMorphiGPU0: FindU and FindV for every pixel and line, to the matrices.
-__global__ void make_morph_uv(const float* target, int n, int width, int height, float* u, float* v) {
+// The pixel a thread of a 2D launch works on: its centre (X, Y), its index p,
+// and the image's pixel count, the stride between the per-line matrices.
+struct PixelThread {
+    float X, Y;
+    std::size_t p, pixels;
+};
+__device__ bool pixel_thread(int width, int height, PixelThread& t) {
     const int x = blockIdx.x * blockDim.x + threadIdx.x;
     const int y = blockIdx.y * blockDim.y + threadIdx.y;
-    if (x >= width || y >= height) return;
-    const float X = x + 0.5f, Y = y + 0.5f;
-    const std::size_t pixels = static_cast<std::size_t>(width) * height;
-    const std::size_t p = static_cast<std::size_t>(y) * width + x;
+    if (x >= width || y >= height) return false;
+    t = {x + 0.5f, y + 0.5f, static_cast<std::size_t>(y) * width + x, static_cast<std::size_t>(width) * height};
+    return true;
+}
+
+// MakeMorphiGPU0: FindU and FindV for every pixel and line, to the matrices.
+__global__ void make_morph_uv(const float* target, int n, int width, int height, float* u, float* v) {
+    PixelThread t;
+    if (!pixel_thread(width, height, t)) return;
+    const float X = t.X, Y = t.Y;
+    const std::size_t pixels = t.pixels, p = t.p;
     for (int i = 0; i < n; ++i) {
         const float px = target[4 * i], py = target[4 * i + 1];
         const float dx = target[4 * i + 2] - px, dy = target[4 * i + 3] - py;
@@ -51,12 +63,10 @@ __global__ void make_morph_uv(const float* target, int n, int width, int height,
 __global__ void make_morph_position(const float* target, const float* lines, int n, const float* u, const float* v,
                                     const std::uint8_t* key, int width, int height, float a, float b, float p_exp,
                                     std::uint8_t* warped) {
-    const int x = blockIdx.x * blockDim.x + threadIdx.x;
-    const int y = blockIdx.y * blockDim.y + threadIdx.y;
-    if (x >= width || y >= height) return;
-    const float X = x + 0.5f, Y = y + 0.5f;
-    const std::size_t pixels = static_cast<std::size_t>(width) * height;
-    const std::size_t p = static_cast<std::size_t>(y) * width + x;
+    PixelThread t;
+    if (!pixel_thread(width, height, t)) return;
+    const float X = t.X, Y = t.Y;
+    const std::size_t pixels = t.pixels, p = t.p;
     float sx = 0.0f, sy = 0.0f, wsum = 0.0f;
     for (int i = 0; i < n; ++i) {
         const float uu = u[i * pixels + p], vv = v[i * pixels + p];

@@ -7,8 +7,6 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
-#include <future>
-#include <thread>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -17,6 +15,7 @@
 #include <spdlog/spdlog.h>
 
 #include "emoface/common/error.h"
+#include "emoface/common/parallel.h"
 #include "emoface/expression/default_face.h"
 #include "emoface/expression/face_io.h"
 #include "emoface/fap/fap_io.h"
@@ -249,18 +248,16 @@ Session::Session(const SessionOptions& options, render::Platform* window) : opti
         a.keys = render::read_wrinkle_keys(options_.wrinkle_folder, a.lines);
         options_.wrinkle_size = a.keys.front().map.width;
     }
-    std::vector<std::future<render::WrinkleKey>> keys;
-    const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
     a.keys.resize(expression::kWrinkleKeyCount);
-    for (int k = 0; k < expression::kWrinkleKeyCount && options_.wrinkle_folder.empty(); ++k) {
-        auto make = [&a, &spec, k, size = options_.wrinkle_size] {
-            expression::FapValues pose{};
-            if (k > 0) pose = a.emotions.profiles[std::size_t(k - 1)];
-            return render::make_wrinkle_key(a.face, *a.rig, spec, expression::WrinkleKey(k), pose, size);
-        };
-        keys.push_back(std::async(threads > 1 ? std::launch::async : std::launch::deferred, make));
-    }
-    for (std::size_t k = 0; k < keys.size(); ++k) a.keys[k] = keys[k].get();
+    if (options_.wrinkle_folder.empty())
+        parallel_for(expression::kWrinkleKeyCount, 1, [&](int begin, int end) {
+            for (int k = begin; k < end; ++k) {
+                expression::FapValues pose{};
+                if (k > 0) pose = a.emotions.profiles[std::size_t(k - 1)];
+                a.keys[std::size_t(k)] = render::make_wrinkle_key(a.face, *a.rig, spec, expression::WrinkleKey(k),
+                                                                  pose, options_.wrinkle_size);
+            }
+        });
     load_.keys_ms = ms_since(t);
 
     t = Clock::now();
@@ -278,6 +275,7 @@ Session::Session(const SessionOptions& options, render::Platform* window) : opti
         load_.platform_ms = ms_since(t);
     }
     spdlog::debug("session: {}", platform_->description());
+    spdlog::debug("session: CUDA device for the morph: {}", morph::cuda_device_description());
 
     t = Clock::now();
     make_scene();

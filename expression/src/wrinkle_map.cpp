@@ -4,12 +4,12 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
-#include <thread>
 
 #include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
 
 #include "emoface/common/error.h"
+#include "emoface/common/parallel.h"
 
 namespace emoface::expression {
 namespace {
@@ -270,15 +270,12 @@ struct SkinMask {
     }
 };
 
+// Rows on the shared pool, a few at a time; each row is written by one call.
 template <typename RowFn>
 void for_each_row_band(int rows, RowFn&& fn) {
-    const int threads = std::max(1u, std::min(8u, std::thread::hardware_concurrency()));
-    std::vector<std::thread> pool;
-    for (int t = 0; t < threads; ++t)
-        pool.emplace_back([&, t] {
-            for (int row = t; row < rows; row += threads) fn(row);
-        });
-    for (auto& th : pool) th.join();
+    parallel_for(rows, 8, [&](int begin, int end) {
+        for (int row = begin; row < end; ++row) fn(row);
+    });
 }
 
 }  // namespace

@@ -55,8 +55,14 @@ std::unique_ptr<BackendImpl> make_cpu_backend(int width, int height, PixelFormat
 #if defined(EMOFACE_MORPH_CUDA)
 std::unique_ptr<BackendImpl> make_cuda_backend(int width, int height, PixelFormat format,
                                                const std::vector<KeyMap>& keys);
-bool cuda_device_usable(std::string* why);
-std::string cuda_describe_device();
+// Found once per process, on first use.
+struct CudaStatus {
+    bool usable = false;     // a device this build has code for
+    bool gpu_found = false;  // the driver answers and counts at least one device
+    std::string why;         // when not usable: the CUDA error or what is missing
+    std::string description; // "NVIDIA H100 80GB HBM3 (sm_90, 132 SMs)"
+};
+const CudaStatus& cuda_status();
 #endif
 
 }  // namespace emoface::morph::detail

@@ -1,5 +1,5 @@
 // The CPU backend: the key maps copied once, the shared kernel body run over
-// rows by a thread pool with one thread per core.
+// rows on the process's thread pool (emoface/common/parallel.h).
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
@@ -7,25 +7,21 @@
 
 #include "backend.h"
 #include "cpu_kernels.h"
-#include "thread_pool.h"
+#include "emoface/common/parallel.h"
 
 namespace emoface::morph::detail {
 namespace {
 
+// The AVX2 + FMA row loops where the build has them and the processor runs
+// them, unless EMOFACE_MORPH_BASELINE=1 asks for the baseline ones (so they
+// are tested on machines that have AVX2, outside the sanitizer build too).
 const CpuKernels& pick_kernels() {
+    const char* baseline = std::getenv("EMOFACE_MORPH_BASELINE");
+    if (baseline != nullptr && std::strcmp(baseline, "1") == 0) return cpu_base::kernels();
 #if defined(EMOFACE_MORPH_HAVE_AVX2) && (defined(__x86_64__) || defined(__i386__))
     if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return cpu_avx2::kernels();
 #endif
     return cpu_base::kernels();
-}
-
-// EMOFACE_MORPH_THREADS=n overrides the thread count (benchmarks, profiling).
-int thread_count() {
-    if (const char* v = std::getenv("EMOFACE_MORPH_THREADS")) {
-        const int n = std::atoi(v);
-        if (n > 0 && n <= 1024) return n;
-    }
-    return 0;
 }
 
 using Clock = std::chrono::steady_clock;
@@ -37,7 +33,7 @@ class CpuBackend final : public BackendImpl {
 public:
     CpuBackend(int width, int height, PixelFormat format, const std::vector<KeyMap>& keys)
         : width_(width), height_(height), is_float_(format == PixelFormat::RgbaF32),
-          kernels_(pick_kernels()), pool_(thread_count()) {
+          kernels_(pick_kernels()) {
         const std::size_t bytes = static_cast<std::size_t>(width) * height * (is_float_ ? 16 : 4);
         auto t0 = Clock::now();
         keys_.resize(keys.size());
@@ -66,7 +62,7 @@ public:
         }
 
         if (plan.accuracy == Accuracy::Exact) {
-            pool_.parallel_for(height_, 1, [&](int y0, int y1) { kernels_.exact_rows(job, y0, y1); });
+            parallel_for(height_, 1, [&](int y0, int y1) { kernels_.exact_rows(job, y0, y1); });
             return;
         }
         // Grid points i·cell cover pixel centres up to the last one, plus one
@@ -77,9 +73,9 @@ public:
             static_cast<std::size_t>(job.grid_w) * job.grid_h * kernel::sum_floats(plan.sources);
         if (grid_.size() < grid_floats) grid_.resize(grid_floats);  // first use / finer cell only
         job.grid = grid_.data();
-        pool_.parallel_for(job.grid_h, 1, [&](int g0, int g1) { kernels_.grid_rows(job, g0, g1); });
+        parallel_for(job.grid_h, 1, [&](int g0, int g1) { kernels_.grid_rows(job, g0, g1); });
         const int cell_rows = (height_ + plan.fast_cell - 1) / plan.fast_cell;
-        pool_.parallel_for(cell_rows, 1, [&](int t0, int t1) { kernels_.apply_rows(job, t0, t1); });
+        parallel_for(cell_rows, 1, [&](int t0, int t1) { kernels_.apply_rows(job, t0, t1); });
     }
 
 private:
@@ -88,7 +84,6 @@ private:
     const CpuKernels& kernels_;
     std::vector<std::vector<unsigned char>> keys_;
     std::vector<float> grid_;
-    ThreadPool pool_;
     SetupTimes times_;
 };
 
@@ -100,3 +95,11 @@ std::unique_ptr<BackendImpl> make_cpu_backend(int width, int height, PixelFormat
 }
 
 }  // namespace emoface::morph::detail
+
+namespace emoface::morph {
+
+const char* cpu_kernels_name() {
+    return &detail::pick_kernels() == &detail::cpu_base::kernels() ? "baseline" : "avx2";
+}
+
+}  // namespace emoface::morph

@@ -30,7 +30,6 @@ struct CpuJob {
 };
 
 struct CpuKernels {
-    const char* name;
     // Exact warp of rows [y0, y1).
     void (*exact_rows)(const CpuJob& job, int y0, int y1);
     // Fast mode, pass 1: grid rows [g0, g1) of sums.
@@ -59,17 +58,11 @@ using kernel::Law;
 // the sums of 8 sources stay in L1 (17 x 64 floats).
 constexpr int kRun = 64;
 
-#if defined(__GNUC__)
-#define EMOFACE_CPU_INLINE inline __attribute__((always_inline))
-#else
-#define EMOFACE_CPU_INLINE inline
-#endif
-
 #if defined(__SSE2__)
 // The per-pixel end on x86: the same bilinear sample and blend as
 // kernel::blend_sources (same clamping, same lerp order), with the four
 // channels of a texel in one SSE register instead of four scalars.
-EMOFACE_CPU_INLINE __m128 texel_ps(const kernel::ImageView& img, const unsigned char* row, int x) {
+EMOFACE_INLINE __m128 texel_ps(const kernel::ImageView& img, const unsigned char* row, int x) {
     if (img.is_float) return _mm_loadu_ps(reinterpret_cast<const float*>(row) + 4 * x);
     int bytes;
     std::memcpy(&bytes, row + 4 * x, 4);
@@ -78,7 +71,7 @@ EMOFACE_CPU_INLINE __m128 texel_ps(const kernel::ImageView& img, const unsigned 
     return _mm_cvtepi32_ps(v);
 }
 
-EMOFACE_CPU_INLINE __m128 sample_ps(const kernel::ImageView& img, float px, float py) {
+EMOFACE_INLINE __m128 sample_ps(const kernel::ImageView& img, float px, float py) {
     const float fx = kernel::clampf(px - 0.5f, 0.0f, static_cast<float>(img.width - 1));
     const float fy = kernel::clampf(py - 0.5f, 0.0f, static_cast<float>(img.height - 1));
     const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
@@ -95,7 +88,7 @@ EMOFACE_CPU_INLINE __m128 sample_ps(const kernel::ImageView& img, float px, floa
 }
 #endif
 
-EMOFACE_CPU_INLINE void store_pixel(const CpuJob& job, int x, int y, const kernel::Rgba& c) {
+EMOFACE_INLINE void store_pixel(const CpuJob& job, int x, int y, const kernel::Rgba& c) {
     unsigned char* row = job.out + static_cast<std::size_t>(y) * job.out_pitch;
     if (job.keys[0].is_float) {
         float* p = reinterpret_cast<float*>(row) + 4 * x;
@@ -111,7 +104,7 @@ EMOFACE_CPU_INLINE void store_pixel(const CpuJob& job, int x, int y, const kerne
 
 // Writes point results: positions, or the sampled and blended pixel.
 template <int K>
-EMOFACE_CPU_INLINE void finish_point(const CpuJob& job, int x, int y, const float (&dx)[K], const float (&dy)[K]) {
+EMOFACE_INLINE void finish_point(const CpuJob& job, int x, int y, const float (&dx)[K], const float (&dy)[K]) {
     const float px = static_cast<float>(x) + 0.5f, py = static_cast<float>(y) + 0.5f;
     if (job.positions != nullptr) {
         float* p = job.positions + (static_cast<std::size_t>(y) * job.width + x) * (2 * K);
@@ -137,6 +130,17 @@ EMOFACE_CPU_INLINE void finish_point(const CpuJob& job, int x, int y, const floa
 #endif
 }
 
+// Points x0 .. of row y (PX of them, fewer at the row's end) from their sums.
+template <int K, int PX>
+EMOFACE_INLINE void finish_run(const CpuJob& job, const Accum<K, PX>& acc, int x0, int y) {
+    const int n = job.width - x0 < PX ? job.width - x0 : PX;
+    for (int j = 0; j < n; ++j) {
+        float dx[K], dy[K];
+        kernel::displacement(acc, j, job.plan->extent, dx, dy);
+        finish_point<K>(job, x0 + j, y, dx, dy);
+    }
+}
+
 // Sums all lines for kRun points spaced `spacing` pixels apart on pixel row
 // coordinate `y_px` (a centre), starting at pixel coordinate x_px.
 template <int K, Law L>
@@ -155,12 +159,7 @@ void exact_rows_t(const CpuJob& job, int y0, int y1) {
     for (int y = y0; y < y1; ++y) {
         for (int x0 = 0; x0 < job.width; x0 += kRun) {
             sum_lines<K, L>(plan, static_cast<float>(x0) + 0.5f, static_cast<float>(y) + 0.5f, 1.0f, acc);
-            const int n = job.width - x0 < kRun ? job.width - x0 : kRun;
-            for (int j = 0; j < n; ++j) {
-                float dx[K], dy[K];
-                kernel::displacement(acc, j, plan.extent, dx, dy);
-                finish_point<K>(job, x0 + j, y, dx, dy);
-            }
+            finish_run(job, acc, x0, y);
         }
     }
 }
@@ -178,21 +177,14 @@ void grid_rows_t(const CpuJob& job, int g0, int g1) {
             sum_lines<K, L>(plan, static_cast<float>(gx0) * cell + 0.5f, static_cast<float>(gy) * cell + 0.5f, cell,
                             acc);
             const int n = job.grid_w - gx0 < kRun ? job.grid_w - gx0 : kRun;
-            for (int j = 0; j < n; ++j) {
-                float* g = job.grid + (static_cast<std::size_t>(gy) * job.grid_w + gx0 + j) * S;
-                g[0] = acc.w[j];
-                for (int k = 0; k < K; ++k) {
-                    g[1 + 2 * k] = acc.dx[k][j];
-                    g[2 + 2 * k] = acc.dy[k][j];
-                }
-            }
+            for (int j = 0; j < n; ++j)
+                kernel::store_sums(acc, j, job.grid + (static_cast<std::size_t>(gy) * job.grid_w + gx0 + j) * S);
         }
     }
 }
 
-// Fast mode, pass 2, for cell rows [t0, t1): per cell, its near lines;
-// the far sums at its corners; per run of R pixels of a cell row, the far
-// sums interpolated along the row plus the near lines' exact terms
+// Fast mode, pass 2, for cell rows [t0, t1): per cell, its near lines and
+// far corner sums; per run of R pixels of a cell row, kernel::cell_run
 // (kernel.h, "fast mode"). R = 8 (4 for 4-pixel cells) keeps the number of
 // instantiations, and the build time, down.
 template <int K, Law L, int R>
@@ -202,33 +194,22 @@ void fast_tiles_t(const CpuJob& job, int t0, int t1) {
     const int C = plan.fast_cell;
     const float inv_c = 1.0f / static_cast<float>(C);
     const float inv = plan.inv_extent;
-    const float reach = (plan.fast_reach + 0.70711f) * static_cast<float>(C) * inv;
+    const kernel::FastGrid grid{plan.records, plan.record_floats, plan.lines, job.grid, job.grid_w, S, C, inv,
+                                kernel::cell_reach(plan.fast_reach, C, inv), plan.b};
     const int tiles_w = (job.width + C - 1) / C;
     unsigned short list[kernel::kMaxNear];
     Accum<K, R> acc;
     for (int ty = t0; ty < t1; ++ty) {
         for (int tx = 0; tx < tiles_w; ++tx) {
-            const float cx = (static_cast<float>(tx * C) + 0.5f + 0.5f * C) * inv;
-            const float cy = (static_cast<float>(ty * C) + 0.5f + 0.5f * C) * inv;
-            const int count = kernel::near_lines(plan.records, plan.record_floats, plan.lines, cx, cy, reach, list);
-            const bool exact = count > kernel::kMaxNear;
+            const int count = kernel::cell_near_lines(grid, tx, ty, list);
             float corner[4][S];
-            if (!exact) {
-                for (int c = 0; c < 4; ++c) {
-                    const int gx = tx + (c & 1), gy = ty + (c >> 1);
-                    kernel::far_sums<K, L>(job.grid + (static_cast<std::size_t>(gy) * job.grid_w + gx) * S,
-                                           plan.records, plan.record_floats, list, count,
-                                           (static_cast<float>(gx * C) + 0.5f) * inv,
-                                           (static_cast<float>(gy * C) + 0.5f) * inv, plan.b, corner[c]);
-                }
-            }
+            if (count <= kernel::kMaxNear) kernel::cell_corner_sums<K, L>(grid, list, count, tx, ty, corner[0], S);
             for (int r = 0; r < C; ++r) {
                 const int y = ty * C + r;
                 if (y >= job.height) break;
-                const float y_iso = (static_cast<float>(y) + 0.5f) * inv;
                 const float fy = static_cast<float>(r) * inv_c;
                 float left[S], right[S];
-                if (!exact) {
+                if (count <= kernel::kMaxNear) {
                     for (int q = 0; q < S; ++q) {
                         left[q] = corner[0][q] + fy * (corner[2][q] - corner[0][q]);
                         right[q] = corner[1][q] + fy * (corner[3][q] - corner[1][q]);
@@ -237,32 +218,9 @@ void fast_tiles_t(const CpuJob& job, int t0, int t1) {
                 for (int i0 = 0; i0 < C; i0 += R) {
                     const int x0 = tx * C + i0;
                     if (x0 >= job.width) break;
-                    const float x_iso = (static_cast<float>(x0) + 0.5f) * inv;
-                    if (exact) {
-                        acc.clear();
-                        for (int l = 0; l < plan.lines; ++l)
-                            kernel::accumulate_line<K, R, L>(
-                                plan.records + static_cast<std::size_t>(l) * plan.record_floats, x_iso, y_iso, inv,
-                                plan.b, acc);
-                    } else {
-                        for (int j = 0; j < R; ++j) {
-                            const float fx = static_cast<float>(i0 + j) * inv_c;
-                            acc.w[j] = left[0] + fx * (right[0] - left[0]);
-                            for (int k = 0; k < K; ++k) {
-                                acc.dx[k][j] = left[1 + 2 * k] + fx * (right[1 + 2 * k] - left[1 + 2 * k]);
-                                acc.dy[k][j] = left[2 + 2 * k] + fx * (right[2 + 2 * k] - left[2 + 2 * k]);
-                            }
-                        }
-                        for (int n = 0; n < count; ++n)
-                            kernel::accumulate_line<K, R, L>(plan.records + list[n] * plan.record_floats, x_iso,
-                                                             y_iso, inv, plan.b, acc);
-                    }
-                    const int run = job.width - x0 < R ? job.width - x0 : R;
-                    for (int j = 0; j < run; ++j) {
-                        float dx[K], dy[K];
-                        kernel::displacement(acc, j, plan.extent, dx, dy);
-                        finish_point<K>(job, x0 + j, y, dx, dy);
-                    }
+                    kernel::cell_run<K, R, L>(grid, list, count, left, right, i0, (static_cast<float>(x0) + 0.5f) * inv,
+                                              (static_cast<float>(y) + 0.5f) * inv, acc);
+                    finish_run(job, acc, x0, y);
                 }
             }
         }
@@ -277,33 +235,20 @@ void apply_rows_t(const CpuJob& job, int t0, int t1) {
         fast_tiles_t<K, L, 8>(job, t0, t1);
 }
 
-// Run-time source count -> template (the weight law is chosen per line).
-#define EMOFACE_CPU_DISPATCH_K(fn, plan, ...)                        \
-    do {                                                             \
-        switch ((plan).sources) {                                    \
-            case 1: fn<1, Law::Runtime>(__VA_ARGS__); break;         \
-            case 2: fn<2, Law::Runtime>(__VA_ARGS__); break;         \
-            case 3: fn<3, Law::Runtime>(__VA_ARGS__); break;         \
-            case 4: fn<4, Law::Runtime>(__VA_ARGS__); break;         \
-            case 5: fn<5, Law::Runtime>(__VA_ARGS__); break;         \
-            case 6: fn<6, Law::Runtime>(__VA_ARGS__); break;         \
-            case 7: fn<7, Law::Runtime>(__VA_ARGS__); break;         \
-            default: fn<8, Law::Runtime>(__VA_ARGS__); break;        \
-        }                                                            \
-    } while (0)
-
+// The weight law is chosen per line (Law::Runtime): one instantiation per
+// source count.
 inline void exact_rows(const CpuJob& job, int y0, int y1) {
-    EMOFACE_CPU_DISPATCH_K(exact_rows_t, *job.plan, job, y0, y1);
+    kernel::with_sources(job.plan->sources, [&](auto k) { exact_rows_t<decltype(k)::value, Law::Runtime>(job, y0, y1); });
 }
 inline void grid_rows(const CpuJob& job, int g0, int g1) {
-    EMOFACE_CPU_DISPATCH_K(grid_rows_t, *job.plan, job, g0, g1);
+    kernel::with_sources(job.plan->sources, [&](auto k) { grid_rows_t<decltype(k)::value, Law::Runtime>(job, g0, g1); });
 }
 inline void apply_rows(const CpuJob& job, int t0, int t1) {
-    EMOFACE_CPU_DISPATCH_K(apply_rows_t, *job.plan, job, t0, t1);
+    kernel::with_sources(job.plan->sources, [&](auto k) { apply_rows_t<decltype(k)::value, Law::Runtime>(job, t0, t1); });
 }
 
 const CpuKernels& kernels() {
-    static const CpuKernels table{EMOFACE_CPU_KERNELS_NAME, &exact_rows, &grid_rows, &apply_rows};
+    static const CpuKernels table{&exact_rows, &grid_rows, &apply_rows};
     return table;
 }
 

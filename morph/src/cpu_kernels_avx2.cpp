@@ -2,5 +2,4 @@
 // -ffp-contract=fast to this file only); chosen at run time when the
 // processor has both.
 #define EMOFACE_CPU_KERNELS_IMPL cpu_avx2
-#define EMOFACE_CPU_KERNELS_NAME "avx2"
 #include "cpu_kernels.h"

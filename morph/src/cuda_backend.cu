@@ -24,6 +24,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "backend.h"
@@ -94,7 +95,7 @@ __global__ void __launch_bounds__(256) upload_kernel(const __grid_constant__ Lin
     for (int i = threadIdx.x; i < count; i += blockDim.x) dst[i] = slice.rec[i];
 }
 
-__device__ __forceinline__ void store_pixel(const KernelArgs& a, int x, int y, const kernel::Rgba& c) {
+__device__ EMOFACE_INLINE void store_pixel(const KernelArgs& a, int x, int y, const kernel::Rgba& c) {
     if (a.out_kind == OutKind::Surface) {
         if (a.is_float)
             surf2Dwrite(make_float4(c.r, c.g, c.b, c.a), a.surface, x * 16, y);
@@ -109,6 +110,21 @@ __device__ __forceinline__ void store_pixel(const KernelArgs& a, int x, int y, c
         reinterpret_cast<float4*>(row)[x] = make_float4(c.r, c.g, c.b, c.a);
     else
         reinterpret_cast<unsigned int*>(row)[x] = kernel::pack_rgba8(c);
+}
+
+// The fast grid and line table as the kernel body sees them.
+template <int K>
+__device__ EMOFACE_INLINE kernel::FastGrid fast_grid(const KernelArgs& a, const LineTable& table) {
+    return {reinterpret_cast<const float*>(a.lines != nullptr ? a.lines : table.rec),
+            a.record_floats,
+            a.n_lines,
+            a.grid,
+            a.grid_w,
+            sums_stride(K),
+            a.cell,
+            a.inv_extent,
+            a.reach,
+            a.b};
 }
 
 // One thread sums all lines for PX points of one lattice row. On small
@@ -152,27 +168,13 @@ __global__ void __launch_bounds__(256) warp_kernel(const __grid_constant__ Kerne
         __syncthreads();
         float* mine = partial + (threadIdx.y * blockDim.x + threadIdx.x) * (S * PX);
 #pragma unroll
-        for (int p = 0; p < PX; ++p) {
-            mine[p * S] = acc.w[p];
-#pragma unroll
-            for (int k = 0; k < K; ++k) {
-                mine[p * S + 1 + 2 * k] = acc.dx[k][p];
-                mine[p * S + 2 + 2 * k] = acc.dy[k][p];
-            }
-        }
+        for (int p = 0; p < PX; ++p) kernel::store_sums(acc, p, mine + p * S);
         __syncthreads();
         if (threadIdx.y != 0) return;
         for (int g = 1; g < static_cast<int>(blockDim.y); ++g) {
             const float* other = partial + (g * blockDim.x + threadIdx.x) * (S * PX);
 #pragma unroll
-            for (int p = 0; p < PX; ++p) {
-                acc.w[p] += other[p * S];
-#pragma unroll
-                for (int k = 0; k < K; ++k) {
-                    acc.dx[k][p] += other[p * S + 1 + 2 * k];
-                    acc.dy[k][p] += other[p * S + 2 + 2 * k];
-                }
-            }
+            for (int p = 0; p < PX; ++p) kernel::add_sums(other + p * S, p, acc);
         }
     }
     if (j >= a.points_h) return;
@@ -187,13 +189,7 @@ __global__ void __launch_bounds__(256) warp_kernel(const __grid_constant__ Kerne
         float dx[K], dy[K];
         kernel::displacement(acc, p, a.extent, dx, dy);
         if (a.out_kind == OutKind::Sums) {
-            float* g = a.sums + (static_cast<std::size_t>(j) * a.points_w + i) * sums_stride(K);
-            g[0] = acc.w[p];
-#pragma unroll
-            for (int k = 0; k < K; ++k) {
-                g[1 + 2 * k] = acc.dx[k][p];
-                g[2 + 2 * k] = acc.dy[k][p];
-            }
+            kernel::store_sums(acc, p, a.sums + (static_cast<std::size_t>(j) * a.points_w + i) * sums_stride(K));
             continue;
         }
         if (a.out_kind == OutKind::Displacement) {
@@ -217,25 +213,13 @@ __global__ void __launch_bounds__(128) tile_kernel(const __grid_constant__ Kerne
     constexpr int S4 = sums_stride(K);
     const int t = blockIdx.x * blockDim.x + threadIdx.x;
     if (t >= a.tiles_w * a.tiles_h) return;
-    const float* records = reinterpret_cast<const float*>(a.lines != nullptr ? a.lines : table.rec);
     const int tx = t % a.tiles_w, ty = t / a.tiles_w;
-    const float half = 0.5f * static_cast<float>(a.cell);
-    const float cx = (static_cast<float>(tx * a.cell) + 0.5f + half) * a.inv_extent;
-    const float cy = (static_cast<float>(ty * a.cell) + 0.5f + half) * a.inv_extent;
+    const kernel::FastGrid g = fast_grid<K>(a, table);
     unsigned short* list = a.near_list + static_cast<std::size_t>(t) * kernel::kMaxNear;
-    const int count = kernel::near_lines(records, a.record_floats, a.n_lines, cx, cy, a.reach, list);
+    const int count = kernel::cell_near_lines(g, tx, ty, list);
     a.near_count[t] = count;
     if (count == 0 || count > kernel::kMaxNear) return;
-    for (int c = 0; c < 4; ++c) {
-        const int gx = tx + (c & 1), gy = ty + (c >> 1);
-        float sums[kernel::sum_floats(K)];
-        kernel::far_sums<K, L>(a.grid + (static_cast<std::size_t>(gy) * a.grid_w + gx) * S4, records, a.record_floats,
-                               list, count, (static_cast<float>(gx * a.cell) + 0.5f) * a.inv_extent,
-                               (static_cast<float>(gy * a.cell) + 0.5f) * a.inv_extent, a.b, sums);
-        float* out = a.tile_sums + (static_cast<std::size_t>(t) * 4 + c) * S4;
-#pragma unroll
-        for (int q = 0; q < kernel::sum_floats(K); ++q) out[q] = sums[q];
-    }
+    kernel::cell_corner_sums<K, L>(g, list, count, tx, ty, a.tile_sums + static_cast<std::size_t>(t) * 4 * S4, S4);
 }
 
 // Fast mode, pass 3: four pixels of one row a thread, all in one cell
@@ -251,8 +235,7 @@ __global__ void __launch_bounds__(256, 3) apply_kernel(const __grid_constant__ K
     const int x0 = (blockIdx.x * blockDim.x + threadIdx.x) * 4;
     const int y = blockIdx.y * blockDim.y + threadIdx.y;
     if (x0 >= a.width || y >= a.height) return;
-    const float* records = reinterpret_cast<const float*>(a.lines != nullptr ? a.lines : table.rec);
-    const int rf = a.record_floats;
+    const kernel::FastGrid g = fast_grid<K>(a, table);
     const int tx = x0 / a.cell, ty = y / a.cell;
     const int tile = ty * a.tiles_w + tx;
     const int count = a.near_count[tile];
@@ -299,23 +282,8 @@ __global__ void __launch_bounds__(256, 3) apply_kernel(const __grid_constant__ K
         const int x = x0 + p;
         const float xp = xi + static_cast<float>(p) * inv;
         Accum<K, 1> acc;
-        if (crowded) {
-            acc.clear();
-            for (int l = 0; l < a.n_lines; ++l)
-                kernel::accumulate_line<K, 1, L>(records + l * rf, xp, yi, 0.0f, a.b, acc);
-        } else {
-            const float fx = static_cast<float>(x - tx * a.cell) * inv_cell;
-            const float* l = reinterpret_cast<const float*>(left);
-            const float* r = reinterpret_cast<const float*>(right);
-            acc.w[0] = l[0] + fx * (r[0] - l[0]);
-#pragma unroll
-            for (int k = 0; k < K; ++k) {
-                acc.dx[k][0] = l[1 + 2 * k] + fx * (r[1 + 2 * k] - l[1 + 2 * k]);
-                acc.dy[k][0] = l[2 + 2 * k] + fx * (r[2 + 2 * k] - l[2 + 2 * k]);
-            }
-            for (int n = 0; n < count; ++n)
-                kernel::accumulate_line<K, 1, L>(records + list[n] * rf, xp, yi, 0.0f, a.b, acc);
-        }
+        kernel::cell_run<K, 1, L>(g, list, count, reinterpret_cast<const float*>(left),
+                                  reinterpret_cast<const float*>(right), x - tx * a.cell, xp, yi, acc);
         float dx[K], dy[K];
         kernel::displacement(acc, 0, a.extent, dx, dy);
         if (a.out_kind == OutKind::Displacement) {
@@ -347,92 +315,20 @@ __global__ void __launch_bounds__(256, 3) apply_kernel(const __grid_constant__ K
 
 // ---- run-time choices -> templates -----------------------------------------
 
-template <int K, int PX, Law L>
-void launch_warp(dim3 grid, dim3 block, std::size_t smem, cudaStream_t s, const KernelArgs& a, const LineTable& t) {
-    warp_kernel<K, PX, L><<<grid, block, smem, s>>>(a, t);
+// fn(K, L) with the frame's source count and weight law as compile-time
+// constants (std::integral_constant).
+template <class Fn>
+void with_sources_and_law(const FramePlan& plan, Fn&& fn) {
+    kernel::with_sources(plan.sources, [&](auto k) {
+        if (plan.law == Law::InverseSquare)
+            fn(k, std::integral_constant<Law, Law::InverseSquare>{});
+        else
+            fn(k, std::integral_constant<Law, Law::Power>{});
+    });
 }
 
-template <int K>
-void launch_warp_k(int px, Law law, dim3 grid, dim3 block, std::size_t smem, cudaStream_t s, const KernelArgs& a,
-                   const LineTable& t) {
-    const bool sq = law == Law::InverseSquare;
-    if constexpr (K <= 3) {
-        if (px == 8) {
-            sq ? launch_warp<K, 8, Law::InverseSquare>(grid, block, smem, s, a, t)
-               : launch_warp<K, 8, Law::Power>(grid, block, smem, s, a, t);
-            return;
-        }
-        if (px == 2) {
-            sq ? launch_warp<K, 2, Law::InverseSquare>(grid, block, smem, s, a, t)
-               : launch_warp<K, 2, Law::Power>(grid, block, smem, s, a, t);
-            return;
-        }
-    }
-    if (px >= 4)
-        sq ? launch_warp<K, 4, Law::InverseSquare>(grid, block, smem, s, a, t)
-           : launch_warp<K, 4, Law::Power>(grid, block, smem, s, a, t);
-    else
-        sq ? launch_warp<K, 1, Law::InverseSquare>(grid, block, smem, s, a, t)
-           : launch_warp<K, 1, Law::Power>(grid, block, smem, s, a, t);
-}
-
-void launch_warp_any(int k, int px, Law law, dim3 grid, dim3 block, std::size_t smem, cudaStream_t s,
-                     const KernelArgs& a, const LineTable& t) {
-    switch (k) {
-        case 1: launch_warp_k<1>(px, law, grid, block, smem, s, a, t); break;
-        case 2: launch_warp_k<2>(px, law, grid, block, smem, s, a, t); break;
-        case 3: launch_warp_k<3>(px, law, grid, block, smem, s, a, t); break;
-        case 4: launch_warp_k<4>(px, law, grid, block, smem, s, a, t); break;
-        case 5: launch_warp_k<5>(px, law, grid, block, smem, s, a, t); break;
-        case 6: launch_warp_k<6>(px, law, grid, block, smem, s, a, t); break;
-        case 7: launch_warp_k<7>(px, law, grid, block, smem, s, a, t); break;
-        default: launch_warp_k<8>(px, law, grid, block, smem, s, a, t); break;
-    }
-}
-
-template <int K>
-void launch_tile_k(Law law, dim3 grid, dim3 block, cudaStream_t s, const KernelArgs& a, const LineTable& t) {
-    if (law == Law::InverseSquare)
-        tile_kernel<K, Law::InverseSquare><<<grid, block, 0, s>>>(a, t);
-    else
-        tile_kernel<K, Law::Power><<<grid, block, 0, s>>>(a, t);
-}
-
-void launch_tile_any(int k, Law law, dim3 grid, dim3 block, cudaStream_t s, const KernelArgs& a,
-                     const LineTable& t) {
-    switch (k) {
-        case 1: launch_tile_k<1>(law, grid, block, s, a, t); break;
-        case 2: launch_tile_k<2>(law, grid, block, s, a, t); break;
-        case 3: launch_tile_k<3>(law, grid, block, s, a, t); break;
-        case 4: launch_tile_k<4>(law, grid, block, s, a, t); break;
-        case 5: launch_tile_k<5>(law, grid, block, s, a, t); break;
-        case 6: launch_tile_k<6>(law, grid, block, s, a, t); break;
-        case 7: launch_tile_k<7>(law, grid, block, s, a, t); break;
-        default: launch_tile_k<8>(law, grid, block, s, a, t); break;
-    }
-}
-
-template <int K>
-void launch_apply_k(Law law, dim3 grid, dim3 block, cudaStream_t s, const KernelArgs& a, const LineTable& t) {
-    if (law == Law::InverseSquare)
-        apply_kernel<K, Law::InverseSquare><<<grid, block, 0, s>>>(a, t);
-    else
-        apply_kernel<K, Law::Power><<<grid, block, 0, s>>>(a, t);
-}
-
-void launch_apply_any(int k, Law law, dim3 grid, dim3 block, cudaStream_t s, const KernelArgs& a,
-                      const LineTable& t) {
-    switch (k) {
-        case 1: launch_apply_k<1>(law, grid, block, s, a, t); break;
-        case 2: launch_apply_k<2>(law, grid, block, s, a, t); break;
-        case 3: launch_apply_k<3>(law, grid, block, s, a, t); break;
-        case 4: launch_apply_k<4>(law, grid, block, s, a, t); break;
-        case 5: launch_apply_k<5>(law, grid, block, s, a, t); break;
-        case 6: launch_apply_k<6>(law, grid, block, s, a, t); break;
-        case 7: launch_apply_k<7>(law, grid, block, s, a, t); break;
-        default: launch_apply_k<8>(law, grid, block, s, a, t); break;
-    }
-}
+template <int N>
+using Int = std::integral_constant<int, N>;
 
 // ---- the backend -------------------------------------------------------------
 
@@ -537,7 +433,7 @@ public:
             const int grid_h = (height_ - 1) / cell + 2;
             a.tiles_w = (width_ + cell - 1) / cell;
             a.tiles_h = (height_ + cell - 1) / cell;
-            a.reach = (plan.fast_reach + 0.70711f) * static_cast<float>(cell) * plan.inv_extent;
+            a.reach = kernel::cell_reach(plan.fast_reach, cell, plan.inv_extent);
             const std::size_t tiles = static_cast<std::size_t>(a.tiles_w) * a.tiles_h;
             ensure(grid_, grid_bytes_,
                    static_cast<std::size_t>(a.grid_w) * grid_h * sums_stride(plan.sources) * sizeof(float));
@@ -555,12 +451,15 @@ public:
             g.sums = grid_;
             launch_points(plan, g, warp_block);
             a.grid = grid_;
-            launch_tile_any(plan.sources, plan.law, dim3(static_cast<unsigned>((tiles + 127) / 128)), dim3(128),
-                            stream_, a, table_);
-            EMOFACE_CUDA_CHECK(cudaGetLastError());
             const dim3 block(8, 32);  // a warp: 8 threads x 4 pixels wide, 4 rows
             const dim3 blocks((width_ + 4 * 8 - 1) / (4 * 8), (height_ + 31) / 32);
-            launch_apply_any(plan.sources, plan.law, blocks, block, stream_, a, table_);
+            with_sources_and_law(plan, [&](auto k, auto law) {
+                constexpr int K = decltype(k)::value;
+                constexpr Law L = decltype(law)::value;
+                tile_kernel<K, L><<<static_cast<unsigned>((tiles + 127) / 128), 128, 0, stream_>>>(a, table_);
+                EMOFACE_CUDA_CHECK(cudaGetLastError());
+                apply_kernel<K, L><<<blocks, block, 0, stream_>>>(a, table_);
+            });
             EMOFACE_CUDA_CHECK(cudaGetLastError());
         }
 
@@ -620,7 +519,19 @@ private:
             1, std::min<std::size_t>(plan.lines, (kSharedBytes - reduce) / record_bytes)));
         const std::size_t smem = a.chunk_lines * record_bytes + reduce;
         if (split) blocks.y = a.points_h;
-        launch_warp_any(plan.sources, px, plan.law, blocks, block, smem, stream_, a, table_);
+        // 8 and 2 points a thread only for up to 3 sources (registers).
+        with_sources_and_law(plan, [&](auto k, auto law) {
+            constexpr int K = decltype(k)::value;
+            constexpr Law L = decltype(law)::value;
+            auto launch = [&](auto points) {
+                warp_kernel<K, decltype(points)::value, L><<<blocks, block, smem, stream_>>>(a, table_);
+            };
+            if constexpr (K <= 3) {
+                if (px == 8) return launch(Int<8>{});
+                if (px == 2) return launch(Int<2>{});
+            }
+            px >= 4 ? launch(Int<4>{}) : launch(Int<1>{});
+        });
         EMOFACE_CUDA_CHECK(cudaGetLastError());
     }
 
@@ -734,15 +645,11 @@ private:
     SetupTimes times_;
 };
 
-struct DeviceStatus {
-    bool usable = false;
-    std::string why;
-    std::string description;
-};
+}  // namespace
 
-const DeviceStatus& device_status() {
-    static const DeviceStatus status = [] {
-        DeviceStatus s;
+const CudaStatus& cuda_status() {
+    static const CudaStatus status = [] {
+        CudaStatus s;
         int count = 0;
         cudaError_t e = cudaGetDeviceCount(&count);
         if (e != cudaSuccess) {
@@ -754,6 +661,7 @@ const DeviceStatus& device_status() {
             s.why = "no CUDA device found";
             return s;
         }
+        s.gpu_found = true;
         int device = 0;
         cudaGetDevice(&device);
         cudaDeviceProp prop{};
@@ -777,22 +685,9 @@ const DeviceStatus& device_status() {
     return status;
 }
 
-}  // namespace
-
 std::unique_ptr<BackendImpl> make_cuda_backend(int width, int height, PixelFormat format,
                                                const std::vector<KeyMap>& keys) {
     return std::make_unique<CudaBackend>(width, height, format, keys);
-}
-
-bool cuda_device_usable(std::string* why) {
-    const DeviceStatus& s = device_status();
-    if (!s.usable && why != nullptr) *why = s.why;
-    return s.usable;
-}
-
-std::string cuda_describe_device() {
-    const DeviceStatus& s = device_status();
-    return s.usable ? s.description : "none (" + s.why + ")";
 }
 
 }  // namespace emoface::morph::detail

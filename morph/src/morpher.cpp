@@ -27,7 +27,7 @@ const char* to_string(PixelFormat format) { return format == PixelFormat::Rgba8 
 
 bool cuda_available() {
 #if defined(EMOFACE_MORPH_CUDA)
-    return detail::cuda_device_usable(nullptr);
+    return detail::cuda_status().usable;
 #else
     return false;
 #endif
@@ -35,7 +35,8 @@ bool cuda_available() {
 
 std::string cuda_device_description() {
 #if defined(EMOFACE_MORPH_CUDA)
-    return detail::cuda_describe_device();
+    const detail::CudaStatus& s = detail::cuda_status();
+    return s.usable ? s.description : "none (" + s.why + ")";
 #else
     return "none (built without the CUDA backend)";
 #endif
@@ -87,9 +88,21 @@ void check_layout(const char* fn, const std::string& what, const Layout& layout,
     }
 }
 
-bool notice_printed_once() {
-    static std::atomic<bool> printed{false};
-    return printed.exchange(true);
+// Backend::Auto without a usable GPU: one plain line a process, on stderr
+// (no "morph:" prefix, which reads like the `emoface morph` command). The
+// CUDA error behind it is for Backend::Cuda's error and
+// cuda_device_description() (`emoface -v` prints it).
+void say_the_morph_runs_on_the_cpu() {
+    static std::atomic<bool> said{false};
+    if (said.exchange(true)) return;
+#if defined(EMOFACE_MORPH_CUDA)
+    std::fputs(detail::cuda_status().gpu_found
+                   ? "the NVIDIA GPU cannot run this build's CUDA code: the morph runs on the CPU\n"
+                   : "no NVIDIA GPU found: the morph runs on the CPU\n",
+               stderr);
+#else
+    std::fputs("this build has no CUDA backend: the morph runs on the CPU\n", stderr);
+#endif
 }
 
 }  // namespace
@@ -273,12 +286,12 @@ Morpher::Morpher(int width, int height, PixelFormat format, std::vector<KeyMap> 
 
     if (backend == Backend::Cuda) {
 #if defined(EMOFACE_MORPH_CUDA)
-        std::string why;
-        if (!detail::cuda_device_usable(&why))
+        const detail::CudaStatus& cuda = detail::cuda_status();
+        if (!cuda.usable)
             fail<EnvironmentError>("morph: Morpher(): Backend::Cuda asked for, but no CUDA device is usable ({}); "
                                    "run on a machine with an NVIDIA GPU and driver, or ask for Backend::Cpu or "
                                    "Backend::Auto",
-                                   why);
+                                   cuda.why);
         m.backend = detail::make_cuda_backend(width, height, format, keys);
         m.kind = Backend::Cuda;
 #else
@@ -288,17 +301,12 @@ Morpher::Morpher(int width, int height, PixelFormat format, std::vector<KeyMap> 
 #endif
     } else if (backend == Backend::Auto) {
 #if defined(EMOFACE_MORPH_CUDA)
-        std::string why;
-        if (detail::cuda_device_usable(&why)) {
+        if (detail::cuda_status().usable) {
             m.backend = detail::make_cuda_backend(width, height, format, keys);
             m.kind = Backend::Cuda;
-        } else if (!notice_printed_once()) {
-            std::fprintf(stderr, "morph: no usable CUDA device (%s), using the CPU backend\n", why.c_str());
         }
-#else
-        if (!notice_printed_once())
-            std::fprintf(stderr, "morph: built without CUDA, using the CPU backend\n");
 #endif
+        if (!m.backend) say_the_morph_runs_on_the_cpu();
     }
     if (!m.backend) {
         m.backend = detail::make_cpu_backend(width, height, format, keys);

@@ -8,7 +8,7 @@
 #include <glm/geometric.hpp>
 
 #include "emoface/common/error.h"
-#include "worker_pool.h"
+#include "emoface/common/parallel.h"
 
 namespace emoface::render {
 namespace {
@@ -103,15 +103,7 @@ void TangentFrames::compute(const expression::TriMesh& mesh, const std::vector<g
     // the work per wake-up large and the result independent of the threads.
     constexpr std::size_t kChunk = 4096;
     auto parallel = [](std::size_t count, const std::function<void(std::size_t, std::size_t)>& body) {
-        const int chunks = int((count + kChunk - 1) / kChunk);
-        if (chunks <= 1) {
-            body(0, count);
-            return;
-        }
-        detail::shared_worker_pool().run(chunks, [&](int c) {
-            const std::size_t begin = std::size_t(c) * kChunk;
-            body(begin, std::min(count, begin + kChunk));
-        });
+        parallel_for(int(count), int(kChunk), [&](int begin, int end) { body(std::size_t(begin), std::size_t(end)); });
     };
 
     // Pass 1, per triangle: dp/du, dp/dv (up to a positive factor) and the

@@ -4,7 +4,9 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -389,6 +391,23 @@ TEST(MorphBackend, AutoFallsBackToTheCpuWithoutADevice) {
     EXPECT_EQ(m.backend(), Backend::Cpu);
 }
 
+// A fresh process (the "threadsafe" death-test style runs the test in a new
+// one), so the once-per-process notice has not been printed yet.
+TEST(MorphBackendDeathTest, AutoWithoutADeviceSaysOncePlainlyThatTheMorphRunsOnTheCpu) {
+    if (cuda_available()) GTEST_SKIP() << "a CUDA device is present: " << cuda_device_description();
+    GTEST_FLAG_SET(death_test_style, "threadsafe");
+    const auto img = random_rgba8(8, 8, 125);
+    EXPECT_EXIT(
+        {
+            for (int i = 0; i < 3; ++i) Morpher m(8, 8, PixelFormat::Rgba8, {key(img.data(), random_layout(2, 126))});
+            std::exit(0);
+        },
+        ::testing::ExitedWithCode(0),
+        // The whole of stderr: one line (POSIX regex, ^ and $ at its ends).
+        "^(no NVIDIA GPU found|the NVIDIA GPU cannot run this build's CUDA code|this build has no CUDA backend): "
+        "the morph runs on the CPU\n$");
+}
+
 TEST(MorphBackend, CudaWithoutADeviceIsAnEnvironmentErrorNamingTheFix) {
     if (cuda_available()) GTEST_SKIP() << "a CUDA device is present: " << cuda_device_description();
     const auto img = random_rgba8(8, 8, 123);
@@ -414,6 +433,152 @@ TEST(MorphBackend, ResultsDoNotDependOnTheThreadSchedule) {
         ASSERT_EQ(max_abs_diff(first, again), 0.0);
     }
 }
+
+// ---- CPU instruction sets ----------------------------------------------------------
+//
+// The CPU row loops are built twice, for AVX2 + FMA and for the target's
+// baseline; a processor with AVX2 runs the first. EMOFACE_MORPH_BASELINE=1
+// forces the baseline loops so this (Release) run tests them too.
+
+// Sets an environment variable for a scope and restores it after.
+class ScopedEnv {
+public:
+    ScopedEnv(const char* name, const char* value) : name_(name) {
+        if (const char* old = std::getenv(name)) old_ = old;
+        if (value != nullptr)
+            ::setenv(name, value, 1);
+        else
+            ::unsetenv(name);
+    }
+    ~ScopedEnv() {
+        if (old_.has_value())
+            ::setenv(name_, old_->c_str(), 1);
+        else
+            ::unsetenv(name_);
+    }
+    ScopedEnv(const ScopedEnv&) = delete;
+    ScopedEnv& operator=(const ScopedEnv&) = delete;
+
+private:
+    const char* name_;
+    std::optional<std::string> old_;
+};
+
+TEST(MorphCpuPath, BaselineSwitchPicksTheBaselineLoops) {
+    {
+        ScopedEnv env("EMOFACE_MORPH_BASELINE", "1");
+        EXPECT_STREQ(cpu_kernels_name(), "baseline");
+    }
+    std::string usual;
+    {
+        ScopedEnv env("EMOFACE_MORPH_BASELINE", nullptr);
+        usual = cpu_kernels_name();
+    }
+    EXPECT_TRUE(usual == "avx2" || usual == "baseline") << usual;
+    ScopedEnv env("EMOFACE_MORPH_BASELINE", "0");  // only "1" switches
+    EXPECT_EQ(cpu_kernels_name(), usual);
+}
+
+struct CpuPathCase {
+    const char* name;
+    int width, height, keys, lines;
+    PixelFormat format;
+    float a, b, p;
+    bool normal_map;
+    int fast_cell;
+};
+
+void check_cpu_paths(const CpuPathCase& c, const MorphParams& params) {
+    const bool is_float = c.format == PixelFormat::RgbaF32;
+    std::vector<std::vector<float>> float_keys;
+    std::vector<std::vector<std::uint8_t>> byte_keys;
+    std::vector<KeyMap> keys;
+    const Layout base = random_layout(c.lines, 201);
+    for (int k = 0; k < c.keys; ++k) {
+        if (params.normal_map)
+            float_keys.push_back(random_normals(c.width, c.height, 210 + k));
+        else
+            float_keys.push_back(to_float(random_rgba8(c.width, c.height, 210 + k)));
+        byte_keys.push_back(quantise(float_keys.back()));
+    }
+    for (int k = 0; k < c.keys; ++k)
+        keys.push_back(key(is_float ? static_cast<const void*>(float_keys[k].data()) : byte_keys[k].data(),
+                           jitter(base, 0.06f, 220 + k)));
+    const Layout target = jitter(base, 0.04f, 230);
+    std::vector<float> weights(c.keys, 1.0f / c.keys);
+    const std::size_t values = static_cast<std::size_t>(c.width) * c.height * 4;
+
+    struct Result {
+        std::string kernels;
+        std::vector<float> positions, pixels;
+    };
+    auto run = [&](const char* baseline) {
+        ScopedEnv env("EMOFACE_MORPH_BASELINE", baseline);
+        Result r;
+        r.kernels = cpu_kernels_name();
+        Morpher m(c.width, c.height, c.format, keys, Backend::Cpu);
+        r.positions.resize(static_cast<std::size_t>(c.width) * c.height * c.keys * 2);
+        m.positions_to_host(target, params, r.positions.data());
+        r.pixels.resize(values);
+        if (is_float) {
+            m.morph_to_host(target, weights, params, r.pixels.data());
+        } else {
+            std::vector<std::uint8_t> out(values);
+            m.morph_to_host(target, weights, params, out.data());
+            for (std::size_t i = 0; i < values; ++i) r.pixels[i] = out[i];
+        }
+        return r;
+    };
+    const Result usual = run(nullptr), baseline = run("1");
+    ASSERT_EQ(baseline.kernels, "baseline");
+    ::testing::Test::RecordProperty("usual_kernels", usual.kernels);
+
+    // FMA contraction and wider vectors only change the rounding.
+    const double lsb = is_float ? 1e-4 : 1.0;
+    EXPECT_LT(max_abs_diff(baseline.positions, usual.positions), 1e-3) << "pixels, against " << usual.kernels;
+    EXPECT_LE(max_abs_diff(baseline.pixels, usual.pixels), lsb) << "against " << usual.kernels;
+    if (params.accuracy == Accuracy::Exact) {
+        std::vector<double> ref_pos;
+        std::vector<Layout> layouts;
+        for (const KeyMap& k : keys) layouts.push_back(k.layout);
+        reference_positions(c.width, c.height, layouts, target, params, ref_pos);
+        double worst = 0.0;
+        for (std::size_t i = 0; i < ref_pos.size(); ++i)
+            worst = std::fmax(worst, std::fabs(baseline.positions[i] - ref_pos[i]));
+        EXPECT_LT(worst, 1e-3) << "pixels, baseline against the reference";
+    }
+}
+
+class MorphCpuPathParity : public ::testing::TestWithParam<CpuPathCase> {};
+
+// The key cases of the tests above (both weight laws, 1 to 8 sources, RGBA8
+// and float, normal maps, exact and fast with both run lengths, crowded
+// cells): the baseline loops agree with the usual ones, and with the double
+// reference.
+TEST_P(MorphCpuPathParity, BaselineAgreesWithTheUsualLoopsAndTheReference) {
+    const CpuPathCase& c = GetParam();
+    for (Accuracy accuracy : {Accuracy::Exact, Accuracy::Fast}) {
+        SCOPED_TRACE(to_string(accuracy));
+        MorphParams params;
+        params.a = c.a;
+        params.b = c.b;
+        params.p = c.p;
+        params.normal_map = c.normal_map;
+        params.accuracy = accuracy;
+        params.fast_cell = c.fast_cell;
+        check_cpu_paths(c, params);
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, MorphCpuPathParity,
+    ::testing::Values(CpuPathCase{"square_K1", 64, 64, 1, 12, PixelFormat::Rgba8, 0.01f, 2.0f, 0.5f, false, 8},
+                      CpuPathCase{"wide_K3", 96, 40, 3, 10, PixelFormat::Rgba8, 0.01f, 2.0f, 0.5f, false, 4},
+                      CpuPathCase{"tall_K2_b1p3", 36, 70, 2, 9, PixelFormat::Rgba8, 0.02f, 1.3f, 0.0f, false, 8},
+                      CpuPathCase{"K8_p1", 32, 32, 8, 6, PixelFormat::Rgba8, 0.005f, 2.0f, 1.0f, false, 4},
+                      CpuPathCase{"normals_K3", 40, 32, 3, 8, PixelFormat::Rgba8, 0.01f, 2.0f, 0.5f, true, 8},
+                      CpuPathCase{"crowded_float_K2", 48, 48, 2, 40, PixelFormat::RgbaF32, 0.01f, 2.0f, 0.5f, false, 4}),
+    [](const auto& info) { return std::string(info.param.name); });
 
 // ---- bad input -------------------------------------------------------------------------
 

@@ -25,18 +25,9 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <type_traits>
 
 #include "emoface/common/hd.h"
-
-// Everything here is small and called in the innermost loops: force inlining
-// on the host too (plain `inline` lets the compiler keep calls there).
-#if defined(__CUDACC__)
-#define EMOFACE_MORPH_INLINE EMOFACE_INLINE
-#elif defined(__GNUC__)
-#define EMOFACE_MORPH_INLINE inline __attribute__((always_inline))
-#else
-#define EMOFACE_MORPH_INLINE inline
-#endif
 
 // EMOFACE_UNROLL: loops over sources (at most kMaxKeys) and other short
 // compile-time loops, unrolled on both sides. EMOFACE_PIXEL_LOOP: the loop over
@@ -82,54 +73,61 @@ struct Rgba {
     float r, g, b, a;
 };
 
+// A frame's source count (1..kMaxKeys, known at run time) as a compile-time
+// K: calls fn(std::integral_constant<int, K>{}), so the sums of each source
+// live in registers. The one place a backend turns the count into a kernel
+// instantiation (host code).
+template <int K = 1, class Fn>
+void with_sources(int sources, Fn&& fn) {
+    if constexpr (K < kMaxKeys) {
+        if (sources > K) {
+            with_sources<K + 1>(sources, fn);
+            return;
+        }
+    }
+    fn(std::integral_constant<int, K>{});
+}
+
 // ---- fast math shared by both sides ---------------------------------------
 
-EMOFACE_HD EMOFACE_MORPH_INLINE float fast_sqrt(float x) {
+// EMOFACE_DEVICE_OR_HOST(d, h): expression d in GPU code, h everywhere else,
+// for the few operations the two sides spell differently.
 #if defined(__CUDA_ARCH__)
+#define EMOFACE_DEVICE_OR_HOST(device, host) (device)
+// PTX's approximate square root and reciprocal (what -use_fast_math would
+// give, without fast math for the whole file).
+__device__ EMOFACE_INLINE float ptx_sqrt_approx(float x) {
     float r;
     asm("sqrt.approx.ftz.f32 %0, %1;" : "=f"(r) : "f"(x));
     return r;
-#else
-    return std::sqrt(x);
-#endif
 }
-
-EMOFACE_HD EMOFACE_MORPH_INLINE float fast_rcp(float x) {
-#if defined(__CUDA_ARCH__)
+__device__ EMOFACE_INLINE float ptx_rcp_approx(float x) {
     float r;
     asm("rcp.approx.ftz.f32 %0, %1;" : "=f"(r) : "f"(x));
     return r;
-#else
-    return 1.0f / x;
-#endif
 }
-
-EMOFACE_HD EMOFACE_MORPH_INLINE float pow_neg(float q, float b) {
-#if defined(__CUDA_ARCH__)
-    return exp2f(-b * __log2f(q));
 #else
-    return std::exp2(-b * std::log2(q));
+#define EMOFACE_DEVICE_OR_HOST(device, host) (host)
 #endif
+
+EMOFACE_HD EMOFACE_INLINE float fast_sqrt(float x) { return EMOFACE_DEVICE_OR_HOST(ptx_sqrt_approx(x), std::sqrt(x)); }
+EMOFACE_HD EMOFACE_INLINE float fast_rcp(float x) { return EMOFACE_DEVICE_OR_HOST(ptx_rcp_approx(x), 1.0f / x); }
+EMOFACE_HD EMOFACE_INLINE float pow_neg(float q, float b) {
+    return EMOFACE_DEVICE_OR_HOST(exp2f(-b * __log2f(q)), std::exp2(-b * std::log2(q)));
 }
 
 // Branch-free helpers the CPU compiler turns into max/min/and instructions
 // (std::fmax's NaN rules would stop it vectorising); fabs is a sign-bit
 // mask on the CPU and a free operand modifier on the GPU.
-EMOFACE_HD EMOFACE_MORPH_INLINE float max0(float x) { return x > 0.0f ? x : 0.0f; }
-EMOFACE_HD EMOFACE_MORPH_INLINE float absf(float x) {
-#if defined(__CUDA_ARCH__)
-    return fabsf(x);
-#else
-    return std::fabs(x);
-#endif
-}
-EMOFACE_HD EMOFACE_MORPH_INLINE float clampf(float x, float lo, float hi) {
+EMOFACE_HD EMOFACE_INLINE float max0(float x) { return x > 0.0f ? x : 0.0f; }
+EMOFACE_HD EMOFACE_INLINE float absf(float x) { return EMOFACE_DEVICE_OR_HOST(fabsf(x), std::fabs(x)); }
+EMOFACE_HD EMOFACE_INLINE float clampf(float x, float lo, float hi) {
     // NaN compares false both ways and ends up at lo: never an out-of-range index.
     return x > lo ? (x < hi ? x : hi) : lo;
 }
 
 template <Law L>
-EMOFACE_HD EMOFACE_MORPH_INLINE float line_weight(float q, float b) {
+EMOFACE_HD EMOFACE_INLINE float line_weight(float q, float b) {
     if constexpr (L == Law::InverseSquare) {
         const float r = fast_rcp(q);
         return r * r;
@@ -147,7 +145,7 @@ struct Accum {
     float dx[K][PX];
     float dy[K][PX];
 
-    EMOFACE_HD EMOFACE_MORPH_INLINE void clear() {
+    EMOFACE_HD EMOFACE_INLINE void clear() {
         EMOFACE_PIXEL_LOOP
         for (int j = 0; j < PX; ++j) w[j] = 0.0f;
         EMOFACE_UNROLL
@@ -165,7 +163,7 @@ struct Accum {
 // in iso units. `rec` is one line record with K sources. u, v and w are
 // computed once per point and reused for every source.
 template <int K, int PX, Law L>
-EMOFACE_HD EMOFACE_MORPH_INLINE void accumulate_line(const float* rec, float x0, float y, float step,
+EMOFACE_HD EMOFACE_INLINE void accumulate_line(const float* rec, float x0, float y, float step,
                                                float b, Accum<K, PX>& acc) {
     const float ex = rec[kEx], ey = rec[kEy];
     const float nx = rec[kNx], ny = rec[kNy];
@@ -215,7 +213,7 @@ EMOFACE_HD EMOFACE_MORPH_INLINE void accumulate_line(const float* rec, float x0,
 // Displacement of point j for source k, in pixels: Σ w D / Σ w scaled by S.
 // With no lines (Σw = 0) the warp is the identity.
 template <int K, int PX>
-EMOFACE_HD EMOFACE_MORPH_INLINE void displacement(const Accum<K, PX>& acc, int j, float extent,
+EMOFACE_HD EMOFACE_INLINE void displacement(const Accum<K, PX>& acc, int j, float extent,
                                             float (&dx)[K], float (&dy)[K]) {
     const float scale = acc.w[j] > 0.0f ? extent / acc.w[j] : 0.0f;
     EMOFACE_UNROLL
@@ -240,22 +238,51 @@ EMOFACE_HD EMOFACE_MORPH_INLINE void displacement(const Accum<K, PX>& acc, int j
 inline constexpr int kMaxNear = 16;  // more near lines: the cell is done exactly
 EMOFACE_HD constexpr int sum_floats(int sources) { return 1 + 2 * sources; }
 
+// The fast mode's grid and line table as both backends hold them: the sums
+// of all lines (sum_floats(K) floats, `stride` apart) at grid points
+// (i·cell + 0.5, j·cell + 0.5) pixels, grid_w of them a row.
+struct FastGrid {
+    const float* records;
+    int record_floats;
+    int lines;
+    const float* sums;
+    int grid_w;
+    int stride;
+    int cell;
+    float inv_extent;
+    float reach;  // cell_reach()
+    float b;
+};
+
+// How far from a cell's centre a line counts as near (iso units): fast_reach
+// cells beyond the cell's half-diagonal.
+EMOFACE_HD EMOFACE_INLINE float cell_reach(float fast_reach, int cell, float inv_extent) {
+    return (fast_reach + 0.70711f) * static_cast<float>(cell) * inv_extent;
+}
+
+// Grid point g along x or y (iso units): the centre of pixel g·cell.
+EMOFACE_HD EMOFACE_INLINE float grid_coord(int g, int cell, float inv_extent) {
+    return (static_cast<float>(g * cell) + 0.5f) * inv_extent;
+}
+
 // Distance (iso units) from point (x, y) to a line's segment.
-EMOFACE_HD EMOFACE_MORPH_INLINE float segment_distance(const float* rec, float x, float y) {
+EMOFACE_HD EMOFACE_INLINE float segment_distance(const float* rec, float x, float y) {
     const float s = x * rec[kEx] + (y * rec[kEy] + rec[kCs]);
     const float v = x * rec[kNx] + (y * rec[kNy] + rec[kCv]);
     const float beyond = max0(absf(s) - rec[kHalfLen]);
     return fast_sqrt(v * v + beyond * beyond);
 }
 
-// The lines whose segment comes within `reach` of a point (a cell's centre,
-// with reach including the cell's half-diagonal). Writes at most kMaxNear
-// indices; returns the full count.
-EMOFACE_HD EMOFACE_MORPH_INLINE int near_lines(const float* records, int record_floats, int lines, float cx, float cy,
-                                         float reach, unsigned short* list) {
+// The lines whose segment comes within g.reach of cell (tx, ty)'s centre.
+// Writes at most kMaxNear indices to `list`; returns the full count (over
+// kMaxNear: the cell is done exactly).
+EMOFACE_HD EMOFACE_INLINE int cell_near_lines(const FastGrid& g, int tx, int ty, unsigned short* list) {
+    const float half = 0.5f * static_cast<float>(g.cell);
+    const float cx = (static_cast<float>(tx * g.cell) + 0.5f + half) * g.inv_extent;
+    const float cy = (static_cast<float>(ty * g.cell) + 0.5f + half) * g.inv_extent;
     int count = 0;
-    for (int i = 0; i < lines; ++i) {
-        if (segment_distance(records + i * record_floats, cx, cy) < reach) {
+    for (int i = 0; i < g.lines; ++i) {
+        if (segment_distance(g.records + i * g.record_floats, cx, cy) < g.reach) {
             if (count < kMaxNear) list[count] = static_cast<unsigned short>(i);
             ++count;
         }
@@ -263,33 +290,79 @@ EMOFACE_HD EMOFACE_MORPH_INLINE int near_lines(const float* records, int record_
     return count;
 }
 
-// sums[0] = Σw, sums[1 + 2k] = Σ w Dx_k, sums[2 + 2k] = Σ w Dy_k (iso units).
-template <int K>
-EMOFACE_HD EMOFACE_MORPH_INLINE void store_sums(const Accum<K, 1>& acc, float* sums) {
-    sums[0] = acc.w[0];
+// Point j's sums: sums[0] = Σw, sums[1 + 2k] = Σ w Dx_k, sums[2 + 2k] = Σ w Dy_k
+// (iso units). store_sums writes them (a grid point, a partial sum), add_sums
+// adds stored ones back.
+template <int K, int PX>
+EMOFACE_HD EMOFACE_INLINE void store_sums(const Accum<K, PX>& acc, int j, float* sums) {
+    sums[0] = acc.w[j];
     EMOFACE_UNROLL
     for (int k = 0; k < K; ++k) {
-        sums[1 + 2 * k] = acc.dx[k][0];
-        sums[2 + 2 * k] = acc.dy[k][0];
+        sums[1 + 2 * k] = acc.dx[k][j];
+        sums[2 + 2 * k] = acc.dy[k][j];
+    }
+}
+template <int K, int PX>
+EMOFACE_HD EMOFACE_INLINE void add_sums(const float* sums, int j, Accum<K, PX>& acc) {
+    acc.w[j] += sums[0];
+    EMOFACE_UNROLL
+    for (int k = 0; k < K; ++k) {
+        acc.dx[k][j] += sums[1 + 2 * k];
+        acc.dy[k][j] += sums[2 + 2 * k];
     }
 }
 
-// The sums of the lines NOT in `list`, at a grid point holding the sums of
-// all lines.
+// One cell before its pixels: the sums of the lines NOT in `list` (its far
+// lines) at its four corners, grid points (tx + (c & 1), ty + (c >> 1)) for
+// c = 0..3, to out + c·out_stride.
 template <int K, Law L>
-EMOFACE_HD EMOFACE_MORPH_INLINE void far_sums(const float* grid_sums, const float* records, int record_floats,
-                                        const unsigned short* list, int count, float x, float y, float b,
-                                        float* out) {
-    Accum<K, 1> near;
-    near.clear();
-    for (int n = 0; n < count; ++n)
-        accumulate_line<K, 1, L>(records + list[n] * record_floats, x, y, 0.0f, b, near);
-    out[0] = grid_sums[0] - near.w[0];
-    EMOFACE_UNROLL
-    for (int k = 0; k < K; ++k) {
-        out[1 + 2 * k] = grid_sums[1 + 2 * k] - near.dx[k][0];
-        out[2 + 2 * k] = grid_sums[2 + 2 * k] - near.dy[k][0];
+EMOFACE_HD EMOFACE_INLINE void cell_corner_sums(const FastGrid& g, const unsigned short* list, int count, int tx,
+                                                int ty, float* out, int out_stride) {
+    for (int c = 0; c < 4; ++c) {
+        const int gx = tx + (c & 1), gy = ty + (c >> 1);
+        const float* all = g.sums + (static_cast<std::size_t>(gy) * g.grid_w + gx) * g.stride;
+        Accum<K, 1> near;
+        near.clear();
+        for (int n = 0; n < count; ++n)
+            accumulate_line<K, 1, L>(g.records + list[n] * g.record_floats, grid_coord(gx, g.cell, g.inv_extent),
+                                     grid_coord(gy, g.cell, g.inv_extent), 0.0f, g.b, near);
+        float* far = out + c * out_stride;
+        far[0] = all[0] - near.w[0];
+        EMOFACE_UNROLL
+        for (int k = 0; k < K; ++k) {
+            far[1 + 2 * k] = all[1 + 2 * k] - near.dx[k][0];
+            far[2 + 2 * k] = all[2 + 2 * k] - near.dy[k][0];
+        }
     }
+}
+
+// One run of R neighbouring pixels of a cell row, the first at column i0 of
+// its cell and at (x, y) iso units: the far sums interpolated between the
+// row's `left` and `right` ends (the cell's corner sums already interpolated
+// to this row), plus the near lines exactly; a crowded cell (count >
+// kMaxNear) sums every line exactly.
+template <int K, int R, Law L>
+EMOFACE_HD EMOFACE_INLINE void cell_run(const FastGrid& g, const unsigned short* list, int count, const float* left,
+                                        const float* right, int i0, float x, float y, Accum<K, R>& acc) {
+    if (count > kMaxNear) {
+        acc.clear();
+        for (int l = 0; l < g.lines; ++l)
+            accumulate_line<K, R, L>(g.records + l * g.record_floats, x, y, g.inv_extent, g.b, acc);
+        return;
+    }
+    const float inv_cell = 1.0f / static_cast<float>(g.cell);
+    EMOFACE_PIXEL_LOOP
+    for (int j = 0; j < R; ++j) {
+        const float fx = static_cast<float>(i0 + j) * inv_cell;
+        acc.w[j] = left[0] + fx * (right[0] - left[0]);
+        EMOFACE_UNROLL
+        for (int k = 0; k < K; ++k) {
+            acc.dx[k][j] = left[1 + 2 * k] + fx * (right[1 + 2 * k] - left[1 + 2 * k]);
+            acc.dy[k][j] = left[2 + 2 * k] + fx * (right[2 + 2 * k] - left[2 + 2 * k]);
+        }
+    }
+    for (int n = 0; n < count; ++n)
+        accumulate_line<K, R, L>(g.records + list[n] * g.record_floats, x, y, g.inv_extent, g.b, acc);
 }
 
 // ---- sampling and blending --------------------------------------------------
@@ -303,7 +376,7 @@ struct ImageView {
     bool is_float;
 };
 
-EMOFACE_HD EMOFACE_MORPH_INLINE Rgba load_texel(const ImageView& img, int x, int y) {
+EMOFACE_HD EMOFACE_INLINE Rgba load_texel(const ImageView& img, int x, int y) {
     const unsigned char* row = img.base + static_cast<std::size_t>(y) * img.pitch;
     if (img.is_float) {
         const float* p = reinterpret_cast<const float*>(row) + 4 * x;
@@ -314,7 +387,7 @@ EMOFACE_HD EMOFACE_MORPH_INLINE Rgba load_texel(const ImageView& img, int x, int
             static_cast<float>(p[3])};
 }
 
-EMOFACE_HD EMOFACE_MORPH_INLINE float lerp2(float p, float q, float r, float s, float tx, float ty) {
+EMOFACE_HD EMOFACE_INLINE float lerp2(float p, float q, float r, float s, float tx, float ty) {
     const float top = p + tx * (q - p);
     const float bottom = r + tx * (s - r);
     return top + ty * (bottom - top);
@@ -322,7 +395,7 @@ EMOFACE_HD EMOFACE_MORPH_INLINE float lerp2(float p, float q, float r, float s, 
 
 // Bilinear sample at pixel coordinates (px, py), pixel centres at i + 0.5,
 // clamped to the edge. RGBA8 values stay in 0..255 units.
-EMOFACE_HD EMOFACE_MORPH_INLINE Rgba sample_bilinear(const ImageView& img, float px, float py) {
+EMOFACE_HD EMOFACE_INLINE Rgba sample_bilinear(const ImageView& img, float px, float py) {
     const float fx = clampf(px - 0.5f, 0.0f, static_cast<float>(img.width - 1));
     const float fy = clampf(py - 0.5f, 0.0f, static_cast<float>(img.height - 1));
     const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
@@ -335,7 +408,7 @@ EMOFACE_HD EMOFACE_MORPH_INLINE Rgba sample_bilinear(const ImageView& img, float
             lerp2(a.b, b.b, c.b, d.b, tx, ty), lerp2(a.a, b.a, c.a, d.a, tx, ty)};
 }
 
-EMOFACE_HD EMOFACE_MORPH_INLINE void add_weighted(Rgba& sum, const Rgba& c, float w) {
+EMOFACE_HD EMOFACE_INLINE void add_weighted(Rgba& sum, const Rgba& c, float w) {
     sum.r += w * c.r;
     sum.g += w * c.g;
     sum.b += w * c.b;
@@ -345,7 +418,7 @@ EMOFACE_HD EMOFACE_MORPH_INLINE void add_weighted(Rgba& sum, const Rgba& c, floa
 // A normal map stores 0.5 + 0.5 n (times 255 for RGBA8). The blend of unit
 // vectors is shorter than 1; renormalise it and keep the encoding. A blend that
 // cancels out (or no source at all) gives the flat normal +z.
-EMOFACE_HD EMOFACE_MORPH_INLINE Rgba renormalise(Rgba c, float unit) {
+EMOFACE_HD EMOFACE_INLINE Rgba renormalise(Rgba c, float unit) {
     const float inv_unit = 1.0f / unit;
     float nx = 2.0f * c.r * inv_unit - 1.0f;
     float ny = 2.0f * c.g * inv_unit - 1.0f;
@@ -364,12 +437,12 @@ EMOFACE_HD EMOFACE_MORPH_INLINE Rgba renormalise(Rgba c, float unit) {
     return {(0.5f + 0.5f * nx) * unit, (0.5f + 0.5f * ny) * unit, (0.5f + 0.5f * nz) * unit, c.a};
 }
 
-EMOFACE_HD EMOFACE_MORPH_INLINE unsigned char to_byte(float v) {
+EMOFACE_HD EMOFACE_INLINE unsigned char to_byte(float v) {
     return static_cast<unsigned char>(clampf(v, 0.0f, 255.0f) + 0.5f);
 }
 
 // RGBA8 packed little-endian into one 32-bit word (r in the low byte).
-EMOFACE_HD EMOFACE_MORPH_INLINE std::uint32_t pack_rgba8(const Rgba& c) {
+EMOFACE_HD EMOFACE_INLINE std::uint32_t pack_rgba8(const Rgba& c) {
     return static_cast<std::uint32_t>(to_byte(c.r)) |
            (static_cast<std::uint32_t>(to_byte(c.g)) << 8) |
            (static_cast<std::uint32_t>(to_byte(c.b)) << 16) |
@@ -379,7 +452,7 @@ EMOFACE_HD EMOFACE_MORPH_INLINE std::uint32_t pack_rgba8(const Rgba& c) {
 // Samples the K sources at X + D_k and blends them by weight: the per-pixel
 // end of the kernel, after the line loop.
 template <int K>
-EMOFACE_HD EMOFACE_MORPH_INLINE Rgba blend_sources(const ImageView* keys, const float* weights, float px, float py, const float (&dx)[K],
+EMOFACE_HD EMOFACE_INLINE Rgba blend_sources(const ImageView* keys, const float* weights, float px, float py, const float (&dx)[K],
                                              const float (&dy)[K], bool normal_map) {
     Rgba sum{0.0f, 0.0f, 0.0f, 0.0f};
     EMOFACE_UNROLL

@@ -83,6 +83,11 @@ struct SetupTimes {
 bool cuda_available();
 // "NVIDIA H100 80GB HBM3 (sm_90, 132 SMs)", or why there is none.
 std::string cuda_device_description();
+// The CPU backend's row loops a Morpher made now would run: "avx2" (AVX2 +
+// FMA, where the build and the processor have them) or "baseline" (the
+// target's base instruction set). EMOFACE_MORPH_BASELINE=1 in the environment
+// forces "baseline"; it is read each time a Morpher is made.
+const char* cpu_kernels_name();
 
 class Morpher {
 public:
