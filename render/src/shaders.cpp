@@ -170,6 +170,7 @@ struct Surface {
     vec2 alpha;      // GGX alpha of the two lobes
     float lobe_weight;
     float cavity;    // 1 open skin, 0 a deep crevice
+    float diffuse_share;  // 1 - the sheen's directional albedo
 };
 
 // One light's contribution (colour `c`, direction `l` towards it).
@@ -190,8 +191,8 @@ vec3 shade_light(Surface s, vec3 l, vec3 c) {
     } else {
         diffuse = vec3(max(dot(s.n, l), 0.0));
     }
-    // Light that the surface reflects does not enter it.
-    vec3 color = diffuse * s.albedo * (1.0 - fresnel(s.f0, n_dot_v));
+    // Light that the sheen reflects does not enter the skin.
+    vec3 color = diffuse * s.albedo * s.diffuse_share;
     float n_dot_l = dot(s.n, l);
     if (n_dot_l > 0.0) {
         vec3 h = normalize(l + s.v);
@@ -251,6 +252,10 @@ vec3 shade_skin(vec3 n_bumped, vec3 n_geo, vec3 base, float cavity) {
     s.alpha = max(roughness * roughness, vec2(1e-3));
     // The cavity dims F0 (Jimenez et al. 2013): crevices lose their sheen.
     s.f0 = u_f0 * s.cavity;
+    float n_dot_v = max(dot(s.n, s.v), 1e-4);
+    float mean_roughness = mix(roughness.y, roughness.x, s.lobe_weight);
+    float sheen = environment_brdf(s.f0, mean_roughness, n_dot_v);
+    s.diffuse_share = 1.0 - sheen;
 
     vec3 key = u_light_position.w == 0.0 ? normalize(u_light_position.xyz)
                                          : normalize(u_light_position.xyz - v_position);
@@ -261,11 +266,9 @@ vec3 shade_skin(vec3 n_bumped, vec3 n_geo, vec3 base, float cavity) {
     // The sky/ground hemisphere: diffuse from the softest normal, specular
     // by the environment BRDF towards the reflection, both occluded in the
     // cavity.
-    float n_dot_v = max(dot(s.n, s.v), 1e-4);
     vec3 ambient_n = u_skin_surface ? normalize(mix(s.n, n_geo, u_normal_softening.r)) : s.n;
-    color += hemisphere(ambient_n) * s.albedo * s.cavity * (1.0 - fresnel(s.f0, n_dot_v));
-    float mean_roughness = mix(roughness.y, roughness.x, s.lobe_weight);
-    color += hemisphere(reflect(-s.v, s.n)) * environment_brdf(s.f0, mean_roughness, n_dot_v) *
+    color += hemisphere(ambient_n) * s.albedo * s.cavity * s.diffuse_share;
+    color += hemisphere(reflect(-s.v, s.n)) * sheen *
              specular_occlusion(n_dot_v, s.cavity, mean_roughness);
     return color;
 }

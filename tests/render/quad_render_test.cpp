@@ -6,6 +6,8 @@
 // to sRGB. The skin model is checked for its properties on the same quad:
 // energy bounded, Fresnel rising at grazing angles, a monotonic tone curve.
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <memory>
 #include <string>
 #include <vector>
@@ -17,6 +19,7 @@
 #include "emoface/common/error.h"
 #include "emoface/render/platform.h"
 #include "emoface/render/renderer.h"
+#include "emoface/render/skin_shading.h"
 #include "emoface/render/wrinkle_texture.h"
 
 namespace {
@@ -355,5 +358,209 @@ TEST(ProjectiveFrames, ShaderClosedFormMatchesCpuTangentFrames) {
     EXPECT_LT(diff / count, 0.1);
     EXPECT_LE(worst, 4);
 }
+
+}  // namespace
+
+namespace {
+
+// --- the skin model on the flat quad ---------------------------------------
+// White (or black) albedo, no wrinkle map, the rig dark unless a test lights
+// it, an orthographic camera far along +z so every pixel is seen from +z.
+// The quad is turned about x by `view_deg` to see it at that angle.
+
+constexpr int kSkinFrame = 16;
+
+SkinShading dark_rig() {
+    SkinShading s;
+    s.fill.colour = s.rim.colour = s.sky = s.ground = glm::vec3(0.0f);
+    s.tone_mapping = ToneMapping::None;
+    s.exposure = 1.0f;
+    return s;
+}
+
+class SkinQuad : public ::testing::Test {
+protected:
+    static void SetUpTestSuite() {
+        PlatformOptions o;
+        o.width = o.height = kSkinFrame;
+        o.samples = 4;
+        platform_ = std::make_unique<HeadlessPlatform>(o);
+        renderer_ = std::make_unique<Renderer>(*platform_);
+        white_ = renderer_->add_mesh(make_quad(UvLayout::VUp), Material{});
+    }
+    static void TearDownTestSuite() {
+        renderer_.reset();
+        platform_.reset();
+    }
+
+    // The mean linear value (sRGB decoded) of the frame's central 4x4 pixels.
+    static glm::vec3 draw(const glm::vec3& albedo, float view_deg, const Light& light,
+                          const SkinShading& skin) {
+        Material m;
+        m.base_color = albedo;
+        renderer_->set_material(white_, m);
+        DrawOptions d;
+        d.camera.position = {0.0f, 0.0f, 50.0f};
+        d.camera.view = glm::lookAt(d.camera.position, glm::vec3(0), glm::vec3(0, 1, 0));
+        d.camera.projection = glm::ortho(-1.0f, 1.0f, -1.0f, 1.0f, 40.0f, 60.0f);
+        // Large enough to fill the frame even when seen at 85 degrees.
+        d.model = glm::rotate(glm::mat4(1.0f), glm::radians(view_deg), glm::vec3(1, 0, 0)) *
+                  glm::scale(glm::mat4(1.0f), glm::vec3(2.0f, 24.0f, 1.0f));
+        d.light = light;
+        d.shading = Shading::Skin;
+        d.skin = skin;
+        platform_->begin_frame();
+        renderer_->draw(d, nullptr);
+        platform_->end_frame();
+        const ImageRGBA8 img = platform_->read_rgba();
+        glm::vec3 sum(0.0f);
+        for (int y = kSkinFrame / 2 - 2; y < kSkinFrame / 2 + 2; ++y)
+            for (int x = kSkinFrame / 2 - 2; x < kSkinFrame / 2 + 2; ++x)
+                for (int c = 0; c < 3; ++c) sum[c] += srgb_to_linear(img.at(x, y)[c] / 255.0f);
+        return sum / 16.0f;
+    }
+
+    static std::unique_ptr<HeadlessPlatform> platform_;
+    static std::unique_ptr<Renderer> renderer_;
+    static Renderer::MeshId white_;
+};
+std::unique_ptr<HeadlessPlatform> SkinQuad::platform_;
+std::unique_ptr<Renderer> SkinQuad::renderer_;
+Renderer::MeshId SkinQuad::white_ = -1;
+
+// White furnace by reciprocity: for a fixed view, the light swept over a
+// Fibonacci sphere of directions, each of radiance 1 over its solid angle.
+// What a white surface sends back, summed, is its directional albedo: at
+// most 1 (all the light it gets), and most of it for a white diffuser.
+TEST_F(SkinQuad, WhiteSurfaceNeverReturnsMoreLightThanItGets) {
+    constexpr int kDirections = 400;
+    constexpr float kIntensity = 0.5f;  // the sharp lobe's peak stays below 1
+    const SkinShading skin = dark_rig();
+    for (const float view_deg : {0.0f, 60.0f, 80.0f}) {
+        double albedo = 0.0;
+        const double golden = 3.14159265358979 * (3.0 - std::sqrt(5.0));
+        for (int k = 0; k < kDirections; ++k) {
+            const double z = 1.0 - (k + 0.5) * 2.0 / kDirections;
+            const double r = std::sqrt(1.0 - z * z), phi = golden * k;
+            Light light;
+            light.position = glm::vec4(float(r * std::cos(phi)), float(r * std::sin(phi)), float(z), 0.0f);
+            light.diffuse = glm::vec3(kIntensity);
+            const glm::vec3 c = draw(glm::vec3(1.0f), view_deg, light, skin);
+            // A light of colour I is E / pi: the solid angle 4 pi / N of
+            // unit radiance gives I = 4 / N.
+            albedo += double(c.g) / kIntensity * 4.0 / kDirections;
+        }
+        // 0.98 head-on and at 60 degrees, 0.83 at 80 (one-bounce GGX loses
+        // some light at grazing angles).
+        EXPECT_LE(albedo, 1.02) << "seen at " << view_deg << " degrees";
+        EXPECT_GE(albedo, view_deg < 70.0f ? 0.9 : 0.75) << "seen at " << view_deg << " degrees";
+    }
+}
+
+// A black surface under a uniform white sky reflects only its sheen, which
+// Fresnel makes rise towards grazing angles: F0 = 0.028 head-on.
+TEST_F(SkinQuad, FresnelSheenRisesAtGrazingAngles) {
+    SkinShading skin = dark_rig();
+    skin.sky = skin.ground = glm::vec3(1.0f);
+    Light off;
+    off.diffuse = glm::vec3(0.0f);
+    float previous = 0.0f;
+    std::vector<float> seen;
+    for (const float view_deg : {0.0f, 40.0f, 60.0f, 75.0f, 85.0f}) {
+        const glm::vec3 c = draw(glm::vec3(0.0f), view_deg, off, skin);
+        EXPECT_NEAR(c.r, c.g, 0.005f) << "an uncoloured reflection";
+        EXPECT_GT(c.g, previous) << "at " << view_deg << " degrees";
+        previous = c.g;
+        seen.push_back(c.g);
+    }
+    EXPECT_NEAR(seen.front(), 0.028f, 0.012f) << "head-on reflectance is about F0";
+    EXPECT_GT(seen.back(), 3.0f * seen.front());
+}
+
+// The ACES curve: black stays black, more light never gives a darker pixel,
+// and bright light rolls off to white instead of clipping early.
+TEST_F(SkinQuad, ToneMappingIsMonotonicAndKeepsBlack) {
+    SkinShading skin = dark_rig();
+    skin.tone_mapping = ToneMapping::Aces;
+    Light light;
+    light.position = glm::vec4(0.0f, 0.0f, 1.0f, 0.0f);
+    glm::vec3 previous(-1.0f);
+    for (const float intensity : {0.0f, 0.01f, 0.03f, 0.1f, 0.2f, 0.4f, 0.8f, 1.5f, 3.0f, 8.0f, 30.0f}) {
+        light.diffuse = glm::vec3(intensity);
+        const glm::vec3 c = draw(glm::vec3(0.8f, 0.6f, 0.5f), 0.0f, light, skin);
+        if (intensity == 0.0f) EXPECT_EQ(c, glm::vec3(0.0f));
+        for (int ch = 0; ch < 3; ++ch) {
+            EXPECT_GE(c[ch], previous[ch]) << "intensity " << intensity << " channel " << ch;
+            if (intensity > 0.0f && intensity <= 1.5f)
+                EXPECT_GT(c[ch], previous[ch]) << "intensity " << intensity << " channel " << ch;
+        }
+        previous = c;
+    }
+    EXPECT_GT(previous.r, 0.95f);
+    EXPECT_LT(previous.r, 1.0f + 1e-6f);
+}
+
+// Without the rig, the wrinkle map's alpha is its cavity: 1 (255) is open
+// skin, the same as no map; a cavity darkens the skin under the key light.
+TEST_F(SkinQuad, WrinkleAlphaIsACavity) {
+    const SkinShading skin = dark_rig();
+    Material m;
+    m.base_color = glm::vec3(0.7f);
+    renderer_->set_material(white_, m);
+    auto draw_with_alpha = [&](const WrinkleTexture* map) {
+        DrawOptions d;
+        d.camera = ortho_camera();
+        d.light = directional({0.2f, 0.3f, 1.0f});
+        d.skin = skin;
+        platform_->begin_frame();
+        renderer_->draw(d, map);
+        platform_->end_frame();
+        return platform_->read_rgba();
+    };
+    auto flat_map = [](std::uint8_t alpha) {
+        auto map = std::make_unique<WrinkleTexture>(4, 4, TexelFormat::RGBA8, NormalEncoding::Unsigned);
+        std::vector<std::uint8_t> px(4 * 4 * 4);
+        for (int i = 0; i < 16; ++i) {
+            px[i * 4 + 0] = 128; px[i * 4 + 1] = 128; px[i * 4 + 2] = 255; px[i * 4 + 3] = alpha;
+        }
+        map->upload(px.data());
+        return map;
+    };
+    const ImageRGBA8 none = draw_with_alpha(nullptr);
+    const auto open = flat_map(255), cavity = flat_map(64);
+    const ImageRGBA8 open_skin = draw_with_alpha(open.get()), creviced = draw_with_alpha(cavity.get());
+    const int c = kSkinFrame / 2;
+    for (int ch = 0; ch < 3; ++ch) {
+        EXPECT_NEAR(open_skin.at(c, c)[ch], none.at(c, c)[ch], 1) << "channel " << ch;
+        EXPECT_LT(creviced.at(c, c)[ch] + 5, open_skin.at(c, c)[ch]) << "channel " << ch;
+    }
+}
+
+#ifdef EMOFACE_DATA_DIR
+// SkinShading's defaults are data/render/skin.json's values.
+TEST(SkinShadingData, DefaultsAreTheDataFile) {
+    const SkinShading loaded = load_skin_shading(std::string(EMOFACE_DATA_DIR) + "/render/skin.json");
+    EXPECT_TRUE(loaded == SkinShading{}) << "render/skin_shading.h and data/render/skin.json differ";
+}
+TEST(SkinShadingData, UnknownKeysAndBadValuesAreInputErrors) {
+    const std::string dir = ::testing::TempDir();
+    std::string text;
+    {
+        std::ifstream in(std::string(EMOFACE_DATA_DIR) + "/render/skin.json");
+        text.assign(std::istreambuf_iterator<char>(in), {});
+    }
+    auto write = [&](const std::string& name, const std::string& body) {
+        std::ofstream(dir + name) << body;
+        return dir + name;
+    };
+    std::string bad = text;
+    bad.replace(bad.find("\"f0\": 0.028"), 11, "\"f0\": 1.5");
+    EXPECT_THROW(load_skin_shading(write("skin_bad_f0.json", bad)), emoface::InputError);
+    bad = text;
+    bad.replace(bad.find("\"aces\""), 6, "\"filmic\"");
+    EXPECT_THROW(load_skin_shading(write("skin_bad_tone.json", bad)), emoface::InputError);
+    EXPECT_THROW(load_skin_shading(dir + "no_such_skin.json"), emoface::InputError);
+}
+#endif
 
 }  // namespace
