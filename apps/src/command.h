@@ -2,8 +2,9 @@
 // Subcommand registry: each cmd_<name>.cpp adds itself with
 //   EMOFACE_COMMAND(add_info_command)
 // where add_info_command(CLI::App& root) creates the subcommand and its
-// callback. Callbacks report failure by throwing emoface::Error (exit 2),
-// emoface::InputError (exit 2) or emoface::EnvironmentError (exit 3).
+// callback. Callbacks report failure by throwing emoface::InputError (exit 2),
+// emoface::EnvironmentError (exit 3) or emoface::InternalError (exit 1); the
+// exit codes are emoface::ExitCode (common/error.h, README "Exit codes").
 #include <CLI/CLI.hpp>
 
 namespace emoface::apps {
@@ -13,9 +14,6 @@ using CommandSetup = void (*)(CLI::App& root);
 struct CommandRegistration {
     explicit CommandRegistration(CommandSetup setup);
 };
-
-// Exit codes shared by every subcommand (README, "Exit codes").
-enum ExitCode : int { kExitOk = 0, kExitBadInput = 2, kExitEnvironment = 3 };
 
 }  // namespace emoface::apps
 

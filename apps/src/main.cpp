@@ -33,16 +33,14 @@ int main(int argc, char** argv) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
         app.exit(e);
-        return kExitBadInput;
-    } catch (const emoface::EnvironmentError& e) {
-        std::fprintf(stderr, "emoface: %s\n", e.what());
-        return kExitEnvironment;
-    } catch (const emoface::Error& e) {
-        std::fprintf(stderr, "emoface: %s\n", e.what());
-        return kExitBadInput;
+        return emoface::kExitBadInput;
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "emoface: internal error: %s\n", e.what());
-        return 1;
+        // One line; the exit code says whose fault it is (README, "Exit codes").
+        std::fprintf(stderr, "emoface: %s\n", emoface::error_line(e).c_str());
+        return emoface::exit_code(e);
+    } catch (...) {
+        std::fprintf(stderr, "emoface: an exception of unknown type (this is a bug)\n");
+        return emoface::kExitInternal;
     }
-    return kExitOk;
+    return emoface::kExitOk;
 }

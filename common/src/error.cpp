@@ -25,8 +25,7 @@ int exit_code(const std::exception& e) {
 std::string error_line(const std::exception& e) {
     if (exit_code(e) != kExitInternal) return e.what();
     if (dynamic_cast<const Error*>(&e)) return fmt::format("{} (this is a bug)", e.what());
-    return fmt::format("unexpected {}: {} (this is a bug)",
-                       dynamic_cast<const std::bad_alloc*>(&e) ? "out of memory" : "exception", e.what());
+    return fmt::format("unexpected exception: {} (this is a bug)", e.what());
 }
 
 }  // namespace emoface

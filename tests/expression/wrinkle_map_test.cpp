@@ -453,8 +453,32 @@ TEST(FeatureLayouts, RoundTripThroughJson) {
             EXPECT_NEAR(back.points[i].x, layout.points[i].x, 1e-6f);
             EXPECT_NEAR(back.points[i].y, layout.points[i].y, 1e-6f);
         }
-    EXPECT_THROW(layout_from_json(R"({"points": {"4.1": [0.5]}})", "x.json"), InputError);
-    EXPECT_THROW(layout_from_json(R"({"points": {"99.1": [0.5, 0.5]}})", "x.json"), InputError);
+}
+
+TEST(FeatureLayouts, BadLayoutJsonNamesTheKey) {
+    struct Case {
+        const char* json;
+        const char* message;  // after "expression: x.layout.json"
+    } cases[] = {
+        {R"({"points": {"4.1": [0.5]}})", ": points.\"4.1\": expected an array of 2 numbers, found [0.5]"},
+        {R"({"points": {"4.1": [0.5, "a"]}})", ": points.\"4.1\": expected an array of 2 numbers, found [0.5,\"a\"]"},
+        {R"({"points": {"99.1": [0.5, 0.5]}})",
+         ": points.\"99.1\": expected an MPEG-4 feature point id as the key, found \"99.1\""},
+        {R"({"points": {}, "conventoin": "x right, y down"})",
+         ": conventoin: expected a known key (points, convention), found \"conventoin\""},
+        {R"({"pionts": {}})", ": points: expected a value, found no such key"},
+        {R"([1, 2])", ": expected an object, found [1,2]"},
+        {"{\"points\": {\n\"4.1\": [0.5, 0.5],\n}}", ":3: expected valid JSON, found syntax error while parsing object key - "
+                                               "unexpected '}'; expected string literal"},
+    };
+    for (const Case& c : cases) {
+        try {
+            layout_from_json(c.json, "x.layout.json");
+            ADD_FAILURE() << "accepted " << c.json;
+        } catch (const InputError& e) {
+            EXPECT_EQ(std::string(e.what()), std::string("expression: x.layout.json") + c.message);
+        }
+    }
 }
 
 }  // namespace
