@@ -39,7 +39,7 @@ using kernel::Law;
 using kernel::kMaxKeys;
 
 void cuda_check(cudaError_t e, const char* what) {
-    if (e != cudaSuccess) fail<EnvironmentError>("morph: CUDA: {} failed: {}", what, cudaGetErrorString(e));
+    if (e != cudaSuccess) fail<InternalError>("morph: CUDA: {} failed: {}", what, cudaGetErrorString(e));
 }
 #define EMOFACE_CUDA_CHECK(call) cuda_check((call), #call)
 

@@ -14,8 +14,8 @@ namespace {
 
 void check_cuda(cudaError_t e, const char* what) {
     if (e != cudaSuccess)
-        fail<EnvironmentError>("render: CUDA-GL interop: {}: {} ({})", what,
-                               cudaGetErrorName(e), cudaGetErrorString(e));
+        fail<InternalError>("render: CUDA-GL interop: {}: {} ({})", what, cudaGetErrorName(e),
+                            cudaGetErrorString(e));
 }
 
 }  // namespace

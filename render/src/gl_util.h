@@ -21,7 +21,7 @@ inline const char* gl_error_name(GLenum e) {
 // operation in the message.
 inline void check_gl(const char* what) {
     const GLenum e = glGetError();
-    if (e != GL_NO_ERROR) fail("render: {}: {} (0x{:04x})", what, gl_error_name(e), unsigned(e));
+    if (e != GL_NO_ERROR) fail<InternalError>("render: {}: {} (0x{:04x})", what, gl_error_name(e), unsigned(e));
 }
 
 }  // namespace emoface::render::detail

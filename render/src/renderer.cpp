@@ -67,8 +67,8 @@ GLuint compile(GLenum stage, const char* source) {
         char log[4096] = {};
         glGetShaderInfoLog(s, sizeof log, nullptr, log);
         glDeleteShader(s);
-        fail("render: the {} shader does not compile: {}",
-             stage == GL_VERTEX_SHADER ? "vertex" : "fragment", log);
+        fail<InternalError>("render: the {} shader does not compile: {}",
+                            stage == GL_VERTEX_SHADER ? "vertex" : "fragment", log);
     }
     return s;
 }
@@ -94,7 +94,7 @@ GLuint link_program(const char* vs_source, const char* fs_source) {
         char log[4096] = {};
         glGetProgramInfoLog(p, sizeof log, nullptr, log);
         glDeleteProgram(p);
-        fail("render: the bump-mapping program does not link: {}", log);
+        fail<InternalError>("render: the bump-mapping program does not link: {}", log);
     }
     return p;
 }
