@@ -3,12 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <fstream>
 
 #include <glm/geometric.hpp>
-#include <nlohmann/json.hpp>
 
 #include "emoface/common/error.h"
+#include "json_reader.h"
 #include "emoface/common/parallel.h"
 
 namespace emoface::expression {
@@ -19,86 +18,68 @@ constexpr std::array<const char*, kWrinkleKeyCount> kKeyNames = {
 
 // ---------------------------------------------------------------- loading
 
-struct SpecContext {
-    const std::string& path;
-    std::string where;  // "anger, wrinkle 2 (vertical glabella lines)"
-};
+using detail::JsonReader;
 
-int feature_index(const SpecContext& ctx, const nlohmann::json& value) {
-    if (!value.is_string())
-        fail<InputError>("expression: {}: {}: expected a feature point id such as \"4.1\", found {}",
-                         ctx.path, ctx.where, value.dump());
-    const auto index = fap::find_feature_point(value.get<std::string>());
-    if (!index)
-        fail<InputError>("expression: {}: {}: unknown feature point \"{}\"", ctx.path, ctx.where,
-                         value.get<std::string>());
+int feature_index(const JsonReader& value) {
+    if (!value.is_string()) value.fail("a feature point id such as \"4.1\"");
+    const auto index = fap::find_feature_point(value.as_string());
+    if (!index) value.fail("an MPEG-4 feature point id such as \"4.1\"");
     return *index;
 }
 
-glm::vec2 read_vec2(const SpecContext& ctx, const nlohmann::json& value, const char* field) {
-    if (!value.is_array() || value.size() != 2 || !value[0].is_number() || !value[1].is_number())
-        fail<InputError>("expression: {}: {}: \"{}\" must be [x, y], found {}", ctx.path, ctx.where,
-                         field, value.dump());
-    return {value[0].get<float>(), value[1].get<float>()};
+glm::vec2 read_vec2(const JsonReader& value) {
+    const auto xy = value.as_numbers<2>();
+    return {static_cast<float>(xy[0]), static_cast<float>(xy[1])};
 }
 
-float read_number(const SpecContext& ctx, const nlohmann::json& object, const char* field,
-                  float fallback, float min, float max) {
-    if (!object.contains(field)) return fallback;
-    const auto& value = object[field];
-    if (!value.is_number() || !std::isfinite(value.get<double>()) || value.get<double>() < min ||
-        value.get<double>() > max)
-        fail<InputError>("expression: {}: {}: \"{}\" must be a number in [{}, {}], found {}",
-                         ctx.path, ctx.where, field, min, max, value.dump());
-    return value.get<float>();
+float read_number(JsonReader& object, const char* key, float fallback, float min, float max) {
+    return static_cast<float>(object.number_in(key, min, max, fallback));
 }
 
-AnchoredPoint read_point(const SpecContext& ctx, const nlohmann::json& item) {
-    if (!item.is_object() || !item.contains("fp"))
-        fail<InputError>("expression: {}: {}: a point must be {{\"fp\": \"4.1\"}} or {{\"fp\": [\"4.1\", \"4.2\"], \"t\": 0.5}}, found {}",
-                         ctx.path, ctx.where, item.dump());
+AnchoredPoint read_point(JsonReader item) {
+    item = item.as_object();
     AnchoredPoint point;
-    const auto& fp = item["fp"];
+    const JsonReader fp = item.at("fp");
     if (fp.is_array()) {
-        if (fp.size() != 2)
-            fail<InputError>("expression: {}: {}: \"fp\" as a list must name 2 feature points, found {}",
-                             ctx.path, ctx.where, fp.dump());
-        point.from = feature_index(ctx, fp[0]);
-        point.to = feature_index(ctx, fp[1]);
-        point.t = read_number(ctx, item, "t", 0.5f, -2.0f, 3.0f);
+        const std::vector<JsonReader> ends = fp.elements();
+        if (ends.size() != 2) fp.fail("2 feature point ids");
+        point.from = feature_index(ends[0]);
+        point.to = feature_index(ends[1]);
+        point.t = read_number(item, "t", 0.5f, -2.0f, 3.0f);
     } else {
-        point.from = feature_index(ctx, fp);
+        point.from = feature_index(fp);
     }
-    if (item.contains("offset")) point.offset = read_vec2(ctx, item["offset"], "offset");
+    if (item.has("offset")) point.offset = read_vec2(item.at("offset"));
+    item.finish();
     return point;
 }
 
-WrinkleProfile read_profile(const SpecContext& ctx, const nlohmann::json& object) {
-    const std::string name = object.value("profile", std::string("groove"));
+WrinkleProfile read_profile(JsonReader& object) {
+    const std::string name = object.string("profile", "groove");
     if (name == "groove") return WrinkleProfile::Groove;
     if (name == "fold") return WrinkleProfile::Fold;
     if (name == "bulge") return WrinkleProfile::Bulge;
     if (name == "dimple") return WrinkleProfile::Dimple;
-    fail<InputError>("expression: {}: {}: profile must be groove, fold, bulge or dimple, found \"{}\"",
-                     ctx.path, ctx.where, name);
+    object.at("profile").fail("groove, fold, bulge or dimple");
 }
 
-WrinkleSpec read_wrinkle(const SpecContext& ctx, const nlohmann::json& item) {
-    if (!item.is_object() || !item.contains("points") || !item["points"].is_array() ||
-        item["points"].empty())
-        fail<InputError>("expression: {}: {}: expected an object with a non-empty \"points\" list",
-                         ctx.path, ctx.where);
+WrinkleSpec read_wrinkle(JsonReader item) {
+    item = item.as_object();
+    item.comment("why");
     WrinkleSpec w;
-    w.name = item.value("name", std::string{});
-    w.profile = read_profile(ctx, item);
-    for (const auto& p : item["points"]) w.points.push_back(read_point(ctx, p));
-    w.depth = read_number(ctx, item, "depth", w.depth, 0.0f, 1.0f);
-    w.width = read_number(ctx, item, "width", w.width, 1e-3f, 1.0f);
-    w.taper = read_number(ctx, item, "taper", w.taper, 0.0f, 0.5f);
-    w.count = static_cast<int>(read_number(ctx, item, "count", 1.0f, 1.0f, 12.0f));
-    if (item.contains("step")) w.step = read_vec2(ctx, item["step"], "step");
-    w.depth_falloff = read_number(ctx, item, "depth_falloff", 1.0f, 0.0f, 2.0f);
-    w.side = read_number(ctx, item, "side", 1.0f, -1.0f, 1.0f) < 0.0f ? -1.0f : 1.0f;
+    w.name = item.string("name", "");
+    w.profile = read_profile(item);
+    const JsonReader points = item.at("points");
+    for (const JsonReader& p : points.elements()) w.points.push_back(read_point(p));
+    if (w.points.empty()) points.fail("at least one point");
+    w.depth = read_number(item, "depth", w.depth, 0.0f, 1.0f);
+    w.width = read_number(item, "width", w.width, 1e-3f, 1.0f);
+    w.taper = read_number(item, "taper", w.taper, 0.0f, 0.5f);
+    w.count = item.has("count") ? item.integer_in("count", 1, 12) : 1;
+    if (item.has("step")) w.step = read_vec2(item.at("step"));
+    w.depth_falloff = read_number(item, "depth_falloff", 1.0f, 0.0f, 2.0f);
+    w.side = read_number(item, "side", 1.0f, -1.0f, 1.0f) < 0.0f ? -1.0f : 1.0f;
+    item.finish();
     return w;
 }
 
@@ -283,42 +264,25 @@ void for_each_row_band(int rows, RowFn&& fn) {
 const char* wrinkle_key_name(WrinkleKey key) { return kKeyNames[static_cast<int>(key)]; }
 
 WrinkleLibrarySpec load_wrinkle_spec(const std::string& path) {
-    std::ifstream in(path);
-    if (!in) fail<InputError>("expression: {}: cannot open the wrinkle specification", path);
-    nlohmann::json doc;
-    try {
-        doc = nlohmann::json::parse(in, nullptr, true, /*ignore_comments=*/true);
-    } catch (const nlohmann::json::exception& e) {
-        fail<InputError>("expression: {}: not valid JSON ({})", path, e.what());
-    }
-    if (!doc.is_object() || !doc.contains("emotions") || !doc["emotions"].is_object())
-        fail<InputError>("expression: {}: expected an object \"emotions\", found none", path);
-    WrinkleLibrarySpec spec;
-    for (const auto& [name, list] : doc["emotions"].items()) {
-        const auto* it = std::find_if(kKeyNames.begin(), kKeyNames.end(),
-                                      [&](const char* n) { return name == n; });
-        if (it == kKeyNames.end())
-            fail<InputError>("expression: {}: unknown emotion \"{}\" (expected neutral, joy, sadness, anger, fear, disgust or surprise)",
-                             path, name);
-        if (!list.is_array())
-            fail<InputError>("expression: {}: \"{}\" must be a list of wrinkles", path, name);
-        auto& out = spec.wrinkles[it - kKeyNames.begin()];
-        int n = 0;
-        for (const auto& item : list) {
-            ++n;
-            const SpecContext ctx{path, fmt::format("{}, wrinkle {} ({})", name, n,
-                                                    item.is_object() ? item.value("name", "?") : "?")};
-            out.push_back(read_wrinkle(ctx, item));
+    return detail::read_json_file(path, [](JsonReader& root) {
+        root.comment("about");
+        WrinkleLibrarySpec spec;
+        JsonReader emotions = root.object("emotions");
+        for (int key = 0; key < kWrinkleKeyCount; ++key) {
+            if (!emotions.has(kKeyNames[key])) continue;
+            for (const JsonReader& item : emotions.at(kKeyNames[key]).elements())
+                spec.wrinkles[key].push_back(read_wrinkle(item));
         }
-    }
-    if (doc.contains("neutral_skin_detail")) {
-        const SpecContext ctx{path, "neutral_skin_detail"};
-        const auto& d = doc["neutral_skin_detail"];
-        spec.neutral_detail.amplitude = read_number(ctx, d, "amplitude", 0.0f, 0.0f, 0.05f);
-        spec.neutral_detail.scale = read_number(ctx, d, "scale", 0.02f, 1e-3f, 1.0f);
-        spec.neutral_detail.octaves = static_cast<int>(read_number(ctx, d, "octaves", 3.0f, 1.0f, 6.0f));
-    }
-    return spec;
+        emotions.finish();
+        if (root.has("neutral_skin_detail")) {
+            JsonReader d = root.object("neutral_skin_detail");
+            spec.neutral_detail.amplitude = read_number(d, "amplitude", 0.0f, 0.0f, 0.05f);
+            spec.neutral_detail.scale = read_number(d, "scale", 0.02f, 1e-3f, 1.0f);
+            spec.neutral_detail.octaves = d.has("octaves") ? d.integer_in("octaves", 1, 6) : 3;
+            d.finish();
+        }
+        return spec;
+    });
 }
 
 std::vector<float> render_height_field(const WrinkleLibrarySpec& spec, WrinkleKey key,
