@@ -11,6 +11,7 @@
 
 #include "command.h"
 #include "emoface/common/error.h"
+#include "emoface/expression/face_state.h"
 #include "emoface/fap/fap_io.h"
 
 namespace {
@@ -118,6 +119,27 @@ void print_text(const std::string& path, const FapStream& s) {
     }
 }
 
+// The FACS Action Units a file shows (face_state on each frame, its AUs
+// inferred from the FAPs): per AU side the peak over the frames, or with
+// `frame` >= 0 that frame's (by index).
+emoface::expression::AuIntensities action_units_of(const FapStream& s, const emoface::expression::EmotionProfiles& p,
+                                                   int frame) {
+    emoface::expression::AuIntensities out;
+    const FapStream resolved = resolve_untransmitted(s);
+    for (std::size_t k = 0; k < resolved.frames.size(); ++k) {
+        if (frame >= 0 && k != std::size_t(frame)) continue;
+        const auto aus = emoface::expression::face_state(resolved.frames[k], p).aus;
+        for (int a = 0; a < emoface::expression::kAuNumberLimit; ++a) {
+            out.left[a] = std::max(out.left[a], aus.left[a]);
+            out.right[a] = std::max(out.right[a], aus.right[a]);
+        }
+    }
+    return out;
+}
+
+// AUs below this are not listed: traces a fit leaves from speech or noise.
+constexpr double kShownAuIntensity = 0.1;
+
 nlohmann::json to_json(const std::string& path, const FapStream& s) {
     const Summary sum = summarize(s);
     nlohmann::json j;
@@ -152,7 +174,13 @@ void add_info_command(CLI::App& root) {
     auto json = std::make_shared<bool>(false);
     sub->add_option("files", *files, "FAP files")->required();
     sub->add_flag("--json", *json, "Print a JSON array, one object per file");
-    sub->callback([files, json] {
+    auto data = std::make_shared<std::string>(EMOFACE_DATA_DIR);
+    auto frame = std::make_shared<int>(-1);
+    sub->add_option("--data", *data, "The project's data folder (for the action units)")->capture_default_str();
+    sub->add_option("--frame", *frame, "Show this frame's action units (index from 0) instead of their peaks")
+        ->check(CLI::NonNegativeNumber);
+    sub->callback([files, json, data, frame] {
+        const auto profiles = emoface::expression::load_emotion_profiles(*data + "/expression/emotions.json");
         // Every file is reported; a bad one is named on stderr and makes the
         // exit code 2 once the others are done.
         std::vector<std::string> failures;
@@ -160,10 +188,25 @@ void add_info_command(CLI::App& root) {
         for (const std::string& path : *files) {
             try {
                 const FapStream s = read_fap_file(path);
-                if (*json)
-                    all.push_back(to_json(path, s));
-                else
+                if (*frame >= 0 && std::size_t(*frame) >= s.frames.size())
+                    throw emoface::InputError(fmt::format("info: {}: --frame {} is past its {} frames", path, *frame,
+                                                          s.frames.size()));
+                const auto aus = action_units_of(s, profiles, *frame);
+                const std::string which = *frame >= 0 ? fmt::format("frame {}", *frame) : "peak";
+                if (*json) {
+                    nlohmann::json j = to_json(path, s);
+                    nlohmann::json a = nlohmann::json::object();
+                    for (int n = 1; n < emoface::expression::kAuNumberLimit; ++n) {
+                        if (aus.left[n] >= kShownAuIntensity) a[fmt::format("AU{}L", n)] = aus.left[n];
+                        if (aus.right[n] >= kShownAuIntensity) a[fmt::format("AU{}R", n)] = aus.right[n];
+                    }
+                    j["action_units"] = {{"of", which}, {"intensities", a}};
+                    all.push_back(j);
+                } else {
                     print_text(path, s);
+                    fmt::print("  AUs       {} ({}; {} and above)\n", aus.to_string(kShownAuIntensity - 1e-9), which,
+                               kShownAuIntensity);
+                }
             } catch (const emoface::Error& e) {
                 failures.push_back(e.what());
                 if (*json) all.push_back({{"file", path}, {"error", e.what()}});
