@@ -21,6 +21,7 @@ struct WrinklesArgs {
     std::string face = "default";
     std::string fdp;
     std::string data = EMOFACE_DATA_DIR;
+    std::string layout = "projective";
 };
 
 void run_wrinkles(const WrinklesArgs& args) {
@@ -34,6 +35,9 @@ void run_wrinkles(const WrinklesArgs& args) {
     if (!fs::is_directory(parent, ec))
         fail<InputError>("wrinkles: --out {}: folder {} does not exist", args.out, parent.string());
 
+    const auto layout = render::parse_wrinkle_layout(args.layout);
+    if (!layout) fail<InputError>("wrinkles: --layout '{}': expected projective or anchored", args.layout);
+
     const auto start = std::chrono::steady_clock::now();
     SessionOptions face_options;
     face_options.face = args.face;
@@ -41,6 +45,7 @@ void run_wrinkles(const WrinklesArgs& args) {
     face_options.data = args.data;
     render::FaceAssetsOptions asset_options;
     asset_options.wrinkle_map_size = args.size;
+    asset_options.layout = *layout;
     const auto assets = render::load_face_assets(load_session_face(face_options), args.data, asset_options);
 
     fs::create_directories(args.out);
@@ -66,6 +71,9 @@ void add_wrinkles_command(CLI::App& root) {
         ->capture_default_str();
     sub->add_option("--fdp", args->fdp, "Feature points of an OBJ face (default: FILE.fdp.json)");
     sub->add_option("--data", args->data, "The project's data folder")->capture_default_str();
+    sub->add_option("--layout", args->layout,
+                    "Texture space of the maps: projective, or anchored (the face's own UVs: paint in UV space)")
+        ->capture_default_str();
     sub->callback([args] { run_wrinkles(*args); });
 }
 

@@ -136,6 +136,9 @@ void check_output_folder(const std::string& path, const std::string& command,
 SessionOptions SessionArgs::resolve(const std::string& command, int width, int height) const {
     SessionOptions o = options;
     o.backend = parse_backend(backend, command);
+    const auto kind = render::parse_wrinkle_layout(layout);
+    if (!kind) fail<InputError>("{}: --layout '{}': expected projective or anchored", command, layout);
+    o.layout = *kind;
     o.wrinkles = !no_wrinkles;
     o.width = width;
     o.height = height;
@@ -165,6 +168,10 @@ void add_session_options(CLI::App& sub, SessionArgs& a) {
     sub.add_option("--texture-size", o.texture_size, "Base-colour image side of the default face (0: face.json's)")
         ->capture_default_str();
     sub.add_option("--data", o.data, "The project's data folder")->capture_default_str();
+    sub.add_option("--layout", a.layout,
+                   "Texture space of the wrinkle maps: projective (frontal projection, the default face) "
+                   "or anchored (the mesh's own UVs, for maps painted in UV space)")
+        ->capture_default_str();
 }
 
 expression::Face load_session_face(const SessionOptions& o) {
@@ -224,6 +231,7 @@ Session::Session(const SessionOptions& options, render::Platform* window) : opti
     auto t = Clock::now();
     assets_ = std::make_unique<render::FaceAssets>();
     render::FaceAssets& a = *assets_;
+    a.layout = options_.layout;
     a.face = load_session_face(options_);
     load_.face_ms = ms_since(t);
 
@@ -255,7 +263,7 @@ Session::Session(const SessionOptions& options, render::Platform* window) : opti
                 expression::FapValues pose{};
                 if (k > 0) pose = a.emotions.profiles[std::size_t(k - 1)];
                 a.keys[std::size_t(k)] = render::make_wrinkle_key(a.face, *a.rig, spec, expression::WrinkleKey(k),
-                                                                  pose, options_.wrinkle_size);
+                                                                  pose, options_.wrinkle_size, options_.layout);
             }
         });
     load_.keys_ms = ms_since(t);

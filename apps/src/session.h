@@ -45,6 +45,9 @@ struct SessionOptions {
     morph::Backend backend = morph::Backend::Auto;
     int wrinkle_size = 512;  // side of the key and morphed wrinkle maps, 256..4096
     bool wrinkles = true;    // false: draw with geometric normals only
+    // The wrinkle maps' texture space: projective (the default face), or
+    // anchored (the mesh's own UVs; maps painted in UV space).
+    render::WrinkleLayout layout = render::WrinkleLayout::Projective;
     // Headless platform only (a window has its own size).
     int width = 640;
     int height = 480;
@@ -60,10 +63,11 @@ struct SessionOptions {
 
 // The options every drawing command shares, as they come from the command
 // line: --face, --fdp, --backend, --wrinkle-size, --samples, --no-wrinkles,
-// --face-resolution, --texture-size, --data.
+// --face-resolution, --texture-size, --data, --layout.
 struct SessionArgs {
     SessionOptions options;
     std::string backend = "auto";
+    std::string layout = "projective";
     bool no_wrinkles = false;
     // Checks and resolves them (InputError starting `command: `); width and
     // height are the headless platform's.

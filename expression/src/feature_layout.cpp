@@ -1,14 +1,17 @@
 #include "emoface/expression/feature_layout.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
 
 #include <glm/geometric.hpp>
+#include <glm/mat3x3.hpp>
 #include <nlohmann/json.hpp>
 
 #include "emoface/common/error.h"
+#include "emoface/expression/face.h"
 
 namespace emoface::expression {
 
@@ -61,6 +64,82 @@ FeatureLayout anchored_layout(const std::array<glm::vec2, kFeatureCount>& uvs,
     layout.present = present;
     for (int i = 0; i < kFeatureCount; ++i)
         if (present[i]) layout.points[i] = {uvs[i].x, 1.0f - uvs[i].y};
+    return layout;
+}
+
+namespace {
+
+// The UV (v up) the skin around `position` gives it: the least-squares affine
+// map (x, y) -> (u, v) of the nearest skin vertices, evaluated at position.
+glm::vec2 skin_uv_at(const Face& face, const Vec3d& position) {
+    constexpr std::size_t kNeighbours = 12;
+    const glm::dvec3 p(position[0], position[1], position[2]);
+    std::vector<std::pair<double, int>> near;
+    for (const auto vh : face.mesh.vertices()) {
+        if (face.parts[std::size_t(vh.idx())] != VertexPart::Skin) continue;
+        const auto& q = face.mesh.point(vh);
+        const glm::dvec3 d = glm::dvec3(q[0], q[1], q[2]) - p;
+        near.emplace_back(glm::dot(d, d), vh.idx());
+    }
+    const std::size_t k = std::min(kNeighbours, near.size());
+    std::partial_sort(near.begin(), near.begin() + std::ptrdiff_t(k), near.end());
+    // Normal equations of [x y 1] * A = [u v], centred on `position` so the
+    // answer is the constant term.
+    glm::dmat3 ata(0.0);
+    glm::dvec3 atu(0.0), atv(0.0);
+    glm::dvec2 mean(0.0);
+    for (std::size_t i = 0; i < k; ++i) {
+        const auto vh = TriMesh::VertexHandle(near[i].second);
+        const auto& q = face.mesh.point(vh);
+        const auto& t = face.mesh.texcoord2D(vh);
+        const glm::dvec3 row(q[0] - p.x, q[1] - p.y, 1.0);
+        ata += glm::outerProduct(row, row);
+        atu += row * double(t[0]);
+        atv += row * double(t[1]);
+        mean += glm::dvec2(t[0], t[1]) / double(k);
+    }
+    // Neighbours (nearly) on a line in the frontal view fix no affine map:
+    // their mean UV. ata's upper 2x2 less the mean's part is k times the
+    // covariance of their x, y.
+    const double n = double(k);
+    const double cxx = ata[0][0] - ata[2][0] * ata[2][0] / n, cyy = ata[1][1] - ata[2][1] * ata[2][1] / n,
+                 cxy = ata[1][0] - ata[2][0] * ata[2][1] / n;
+    if (k < 3 || !(cxx * cyy - cxy * cxy > 1e-6 * (cxx + cyy) * (cxx + cyy))) return glm::vec2(mean);
+    const glm::dmat3 inv = glm::inverse(ata);
+    return glm::vec2(float((inv * atu).z), float((inv * atv).z));
+}
+
+}  // namespace
+
+FeatureLayout anchored_layout(const Face& face) {
+    if (!face.mesh.has_vertex_texcoords2D() || face.parts.size() != face.mesh.n_vertices())
+        fail<InputError>("expression: face '{}' has no UVs of its own for the anchored layout "
+                         "(use the projective layout)",
+                         face.name);
+    std::array<glm::vec2, kFeatureCount> uvs{};
+    std::bitset<kFeatureCount> present;
+    for (int i = 0; i < kFeatureCount; ++i) {
+        const FeaturePointLocation& fp = face.feature_points[std::size_t(i)];
+        if (!fp.present) continue;
+        present[i] = true;
+        if (fp.vertex >= 0 && face.parts[std::size_t(fp.vertex)] == VertexPart::Skin) {
+            const auto& t = face.mesh.texcoord2D(TriMesh::VertexHandle(fp.vertex));
+            uvs[std::size_t(i)] = {t[0], t[1]};
+        } else {
+            uvs[std::size_t(i)] = skin_uv_at(face, fp.position);
+        }
+    }
+    FeatureLayout layout = anchored_layout(uvs, present);
+    glm::vec2 lo(1e30f), hi(-1e30f);
+    for (int i = 0; i < kFeatureCount; ++i)
+        if (present[i]) {
+            lo = glm::min(lo, layout.points[std::size_t(i)]);
+            hi = glm::max(hi, layout.points[std::size_t(i)]);
+        }
+    if (!(hi.x - lo.x > 1e-4f) || !(hi.y - lo.y > 1e-4f))
+        fail<InputError>("expression: face '{}': its feature points' UVs span no area ({}, {})-({}, {}); "
+                         "the anchored layout needs the mesh's own UVs (use the projective layout)",
+                         face.name, lo.x, lo.y, hi.x, hi.y);
     return layout;
 }
 

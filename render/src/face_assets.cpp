@@ -13,6 +13,7 @@ std::unique_ptr<FaceAssets> load_face_assets(expression::Face face, const std::s
                          options.wrinkle_map_size);
     auto a = std::make_unique<FaceAssets>();
     a->face = std::move(face);
+    a->layout = options.layout;
     a->rig = std::make_unique<expression::FaceRig>(a->face);
     const std::string dir = data_dir + "/expression/";
     a->emotions = expression::load_emotion_profiles(dir + "emotions.json");
@@ -27,7 +28,7 @@ std::unique_ptr<FaceAssets> load_face_assets(expression::Face face, const std::s
         expression::FapValues pose{};
         if (k > 0) pose = a->emotions.profiles[std::size_t(k - 1)];
         a->keys.push_back(make_wrinkle_key(a->face, *a->rig, spec, expression::WrinkleKey(k), pose,
-                                           options.wrinkle_map_size));
+                                           options.wrinkle_map_size, options.layout));
     }
     return a;
 }
@@ -53,8 +54,10 @@ std::vector<float> key_weights(const expression::EmotionMix& mix) {
 
 std::unique_ptr<FaceScene> make_face_scene(Platform& platform, const FaceAssets& assets,
                                            const FaceSceneOptions& options) {
+    FaceSceneOptions o = options;
+    o.layout = assets.layout;
     return std::make_unique<FaceScene>(platform, assets.face, *assets.rig, assets.keys,
-                                       assets.lines, options);
+                                       assets.lines, o);
 }
 
 }  // namespace emoface::render

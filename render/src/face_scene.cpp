@@ -4,21 +4,18 @@
 #include <chrono>
 #include <limits>
 
+#include <epoxy/gl.h>
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
 #include "emoface/common/error.h"
+#include "emoface/common/timing.h"
 #include "emoface/render/tangents.h"
 #include "emoface/render/wrinkle_morph.h"
 
 namespace emoface::render {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 enum Group { kSkin = 0, kEyes = 1, kMouth = 2, kGroups = 3 };
 
@@ -55,6 +52,16 @@ morph::Layout to_morph_layout(const std::vector<expression::Segment>& segments) 
 
 }  // namespace
 
+const char* wrinkle_layout_name(WrinkleLayout layout) {
+    return layout == WrinkleLayout::Anchored ? "anchored" : "projective";
+}
+
+std::optional<WrinkleLayout> parse_wrinkle_layout(std::string_view text) {
+    if (text == "projective") return WrinkleLayout::Projective;
+    if (text == "anchored") return WrinkleLayout::Anchored;
+    return std::nullopt;
+}
+
 expression::TextureBox layout_box(const expression::Face& face) {
     const expression::TextureBox& box = face.texture_box;
     if (!(box.max.x > box.min.x) || !(box.max.y > box.min.y))
@@ -65,16 +72,18 @@ expression::TextureBox layout_box(const expression::Face& face) {
 
 expression::FeatureLayout posed_layout(const expression::Face& face,
                                        const expression::FaceRig& rig,
-                                       const expression::FapValues& faps) {
+                                       const expression::FapValues& faps,
+                                       WrinkleLayout layout) {
+    if (layout == WrinkleLayout::Anchored) return expression::anchored_layout(face);
     return layout_of(rig.feature_points(faps), present_points(face), layout_box(face));
 }
 
 WrinkleKey make_wrinkle_key(const expression::Face& face, const expression::FaceRig& rig,
                             const expression::WrinkleLibrarySpec& spec, expression::WrinkleKey key,
-                            const expression::FapValues& pose, int size) {
+                            const expression::FapValues& pose, int size, WrinkleLayout layout) {
     WrinkleKey k;
     k.name = expression::wrinkle_key_name(key);
-    k.layout = posed_layout(face, rig, pose);
+    k.layout = posed_layout(face, rig, pose, layout);
     k.map = expression::generate_wrinkle_map(spec, key, k.layout, size);
     return k;
 }
@@ -104,14 +113,23 @@ struct FaceScene::Part {
 FaceScene::FaceScene(Platform& platform, const expression::Face& face,
                      const expression::FaceRig& rig, std::vector<WrinkleKey> keys,
                      std::vector<expression::FeatureLine> lines, const FaceSceneOptions& options)
-    : platform_(platform), face_(face), rig_(rig), box_(layout_box(face)), lines_(std::move(lines)),
-      params_(options.morph), frames_(options.frames) {
+    : platform_(platform), face_(face), rig_(rig), box_(layout_box(face)),
+      layout_kind_(options.layout), lines_(std::move(lines)), params_(options.morph),
+      frames_(options.frames) {
     params_.normal_map = true;
+    if (layout_kind_ == WrinkleLayout::Anchored && frames_ == WrinkleFrames::Shader)
+        fail("render: FaceScene: WrinkleFrames::Shader has the projective layout's closed form; "
+             "expected WrinkleFrames::Mesh with the anchored layout");
     if (keys.empty()) fail<InputError>("render: FaceScene: no wrinkle keys");
     if (lines_.empty()) fail<InputError>("render: FaceScene: no feature lines");
     if (face.parts.size() != face.mesh.n_vertices())
         fail<InputError>("render: FaceScene: face '{}' has {} vertex parts for {} vertices",
                          face.name, face.parts.size(), face.mesh.n_vertices());
+    // The anchored L* is the face's UV layout, the same every frame.
+    if (layout_kind_ == WrinkleLayout::Anchored) {
+        layout_ = expression::anchored_layout(face);
+        target_ = to_morph_layout(expression::layout_segments(lines_, layout_));
+    }
     const int size_w = keys[0].map.width, size_h = keys[0].map.height;
 
     // The morph: every key with its layout's lines.
@@ -184,6 +202,16 @@ FaceScene::FaceScene(Platform& platform, const expression::Face& face,
         }
         part.wrinkles = m.uses_wrinkle_map;
         part.wrinkle_uvs.assign(part.full_index.size(), glm::vec2(0.0f));
+        // Anchored: the wrinkle map is sampled with the mesh's own UVs, v
+        // turned to run down the image (texel row 0 = v 0 of the wrinkle
+        // texture, as the morph writes it). A map painted on an OBJ's UV
+        // layout thus lies as painted; the tangent frames built from these
+        // UVs have +y down the image, the maps' green-down convention.
+        if (layout_kind_ == WrinkleLayout::Anchored && mesh_.has_vertex_texcoords2D())
+            for (std::size_t i = 0; i < part.full_index.size(); ++i) {
+                const auto& t = mesh_.texcoord2D(mesh_.vertex_handle(part.full_index[i]));
+                part.wrinkle_uvs[i] = glm::vec2(t[0], 1.0f - t[1]);
+            }
         part.fixed_tangents.assign(part.full_index.size(), glm::vec4(1, 0, 0, 1));
         part.id = renderer_->add_mesh(part.mesh, m);
         // Parts the CPU gives no frames to: constant ones, uploaded once.
@@ -213,8 +241,10 @@ void FaceScene::update(const expression::FapValues& faps, const std::vector<floa
     // queued first: on the CUDA backend it then runs on the GPU while the
     // CPU deforms the mesh and uploads it (the draw waits for both).
     auto t = Clock::now();
-    layout_ = layout_of(rig_.feature_points(faps), present_points(face_), box_);
-    target_ = to_morph_layout(expression::layout_segments(lines_, layout_));
+    if (layout_kind_ == WrinkleLayout::Projective) {
+        layout_ = layout_of(rig_.feature_points(faps), present_points(face_), box_);
+        target_ = to_morph_layout(expression::layout_segments(lines_, layout_));
+    }
     const double layout_ms = ms_since(t);
     update_wrinkles(key_weights);
     deform(faps, /*layout_from_mesh=*/false);
@@ -239,7 +269,8 @@ void FaceScene::deform(const expression::FapValues& faps, bool layout_from_mesh)
     expression::FaceRig::write_to(deformed_, mesh_);
     times_.rig_ms = ms_since(t);
 
-    if (layout_from_mesh) {
+    const bool projective = layout_kind_ == WrinkleLayout::Projective;
+    if (layout_from_mesh && projective) {
         t = Clock::now();
         layout_ = layout_of(deformed_.feature_points, present_points(face_), box_);
         target_ = to_morph_layout(expression::layout_segments(lines_, layout_));
@@ -259,7 +290,7 @@ void FaceScene::deform(const expression::FapValues& faps, bool layout_from_mesh)
             const auto& p = full_points[part.full_index[i]];
             points[i] = p;
             normals[i] = full_normals[part.full_index[i]];
-            if (cpu_frames)
+            if (cpu_frames && projective)
                 part.wrinkle_uvs[i] = expression::project_to_texture(glm::vec3(p[0], p[1], p[2]), box_);
         }
         times_.uv_ms += ms_since(t);
@@ -273,6 +304,11 @@ void FaceScene::deform(const expression::FapValues& faps, bool layout_from_mesh)
             renderer_->update_shape(part.id, part.mesh);
         times_.upload_ms += ms_since(t);
     }
+}
+
+void FaceScene::finish() {
+    platform_.make_current();
+    glFinish();
 }
 
 void FaceScene::draw(const DrawOptions& options) {

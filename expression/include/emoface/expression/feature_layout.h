@@ -60,6 +60,22 @@ FeatureLayout projective_layout(const fap::FeaturePointPositions& positions,
 FeatureLayout anchored_layout(const std::array<glm::vec2, kFeatureCount>& uvs,
                               const std::bitset<kFeatureCount>& present);
 
+struct Face;
+
+// The anchored layout of a face with its own UVs (the mesh's texcoords2D, v
+// up): where each present feature point sits in the face's UV space, y down.
+// A feature point on a skin vertex takes that vertex's UV. One on another part
+// (the pupils 3.5/3.6 on the eyeballs, teeth, tongue) or at a free position
+// (7.1 inside the neck) has no UV of the skin, yet the wrinkles are placed
+// from it (the pupils set the face unit): it gets the UV the skin around it
+// would give it, an affine map from frontal position (x, y) to UV fitted by
+// least squares to the nearest skin vertices. This assumes the skin's UVs are
+// one upright island around the face (the brows above the eyes, the face's
+// left to the image's right), which is what painting wrinkles across the
+// glabella needs anyway. Throws emoface::InputError naming the face when the
+// mesh has no UVs, or the feature points' UVs span no area.
+FeatureLayout anchored_layout(const Face& face);
+
 // A layout as JSON, so a painted key map can come with its own layout:
 //   {"convention": "...", "points": {"2.1": [x, y], ...}}
 // with x, y normalised, y down the image. Points not listed are absent.

@@ -23,11 +23,13 @@ struct FaceAssets {
     expression::VisemeProfiles visemes;
     std::vector<expression::FeatureLine> lines;  // those the face has both ends of
     std::vector<WrinkleKey> keys;                // by expression::WrinkleKey
+    WrinkleLayout layout = WrinkleLayout::Projective;  // the texture space of the keys
 };
 
 struct FaceAssetsOptions {
     int wrinkle_map_size = 1024;          // 256..4096
     expression::DefaultFaceOptions face;  // the default face's resolution
+    WrinkleLayout layout = WrinkleLayout::Projective;
 };
 
 // Loads the profiles, lines and wrinkle library from `data_dir` (the
@@ -43,7 +45,8 @@ std::unique_ptr<FaceAssets> load_default_face_assets(const std::string& data_dir
 // (1 - sum), then joy .. surprise.
 std::vector<float> key_weights(const expression::EmotionMix& mix);
 
-// A scene on the assets (which must outlive it).
+// A scene on the assets (which must outlive it), in the assets' layout
+// (options.layout is replaced by it).
 std::unique_ptr<FaceScene> make_face_scene(Platform& platform, const FaceAssets& assets,
                                            const FaceSceneOptions& options = {});
 

@@ -1,16 +1,21 @@
 #pragma once
 // One frame of the pipeline (DESIGN.md, "One frame") on a face:
-//   FAPs -> rig (mesh + feature points) -> target layout L* (feature points
-//   projected into the face's texture box) -> morph of the key wrinkle maps
-//   onto L* into the wrinkle texture (interop on the GPU) -> wrinkle UVs
-//   (every vertex projected the same way) -> tangent frames -> draw.
+//   FAPs -> rig (mesh + feature points) -> target layout L* -> morph of the
+//   key wrinkle maps onto L* into the wrinkle texture (interop on the GPU) ->
+//   wrinkle UVs -> tangent frames -> draw.
+// The wrinkle layout (WrinkleLayout) says which texture space the maps live
+// in: projective (L* and the wrinkle UVs are the current feature points and
+// vertices projected into the face's texture box, every frame) or anchored
+// (the mesh's own UVs: L* and the wrinkle UVs are fixed, the morph blends).
 // The face's mesh is drawn as three meshes with their own materials: skin
 // (bump-mapped with the wrinkle map), eyeballs (glossy, no wrinkles) and the
 // mouth interior (teeth, tongue, cavity; no wrinkles).
 #include <array>
 #include <bitset>
 #include <memory>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "emoface/expression/face.h"
@@ -32,35 +37,60 @@ struct WrinkleKey {
     expression::FeatureLayout layout;
 };
 
+// Which texture space the wrinkle maps live in (DESIGN.md "Texture layouts").
+enum class WrinkleLayout {
+    // A frontal projection of the face into its texture box, made again each
+    // frame: the keys are made at their own expression's layout and warped
+    // onto the current one; the wrinkle UVs are the vertices projected the
+    // same way. For faces without UVs of their own (the default face's UVs
+    // are this projection at rest).
+    Projective,
+    // The mesh's own UVs (an artist's, v up as OBJ stores them, used as
+    // (u, 1 - v) so that v runs down the image like every map here): the
+    // feature points and the wrinkle UVs stay put in that space, so every
+    // key's layout is L* and the morph reduces to a weighted blend. Key maps
+    // are painted (or generated) in the mesh's UV space.
+    Anchored,
+};
+const char* wrinkle_layout_name(WrinkleLayout layout);  // "projective", "anchored"
+// "projective" | "anchored"; nullopt for anything else.
+std::optional<WrinkleLayout> parse_wrinkle_layout(std::string_view text);
+
 // The face-space box of `face` as the layout functions take it.
 expression::TextureBox layout_box(const expression::Face& face);
 
-// The layout of the face posed by `faps`: its feature points projected into
-// the face's texture box.
+// The layout of the face posed by `faps`: projective, its feature points
+// projected into the face's texture box; anchored, their UVs
+// (expression::anchored_layout(face), the same in every pose).
 expression::FeatureLayout posed_layout(const expression::Face& face,
                                        const expression::FaceRig& rig,
-                                       const expression::FapValues& faps);
+                                       const expression::FapValues& faps,
+                                       WrinkleLayout layout = WrinkleLayout::Projective);
 
-// One key per (key, pose): the library's wrinkles of `key` generated at the
-// layout of the face posed by `pose` (the key expression at full intensity),
-// size x size pixels.
+// One key per (key, pose): the library's wrinkles of `key` generated at
+// posed_layout(face, rig, pose, layout) (pose: the key expression at full
+// intensity), size x size pixels.
 WrinkleKey make_wrinkle_key(const expression::Face& face, const expression::FaceRig& rig,
                             const expression::WrinkleLibrarySpec& spec, expression::WrinkleKey key,
-                            const expression::FapValues& pose, int size);
+                            const expression::FapValues& pose, int size,
+                            WrinkleLayout layout = WrinkleLayout::Projective);
 
 // Where the skin's wrinkle UVs and tangent frames come from each frame.
 enum class WrinkleFrames {
-    // Projected and computed on the CPU (TangentFrames on the deformed mesh)
-    // and uploaded: works for any UV set.
+    // Projected (or the mesh's UVs) and computed on the CPU (TangentFrames on
+    // the deformed mesh) and uploaded: works for any UV set and either layout.
     Mesh,
     // Derived in the vertex shader from the position and normal: the
     // projective layout's UVs and their tangent frames have a closed form.
+    // Projective layout only.
     Shader,
 };
 
 struct FaceSceneOptions {
     morph::Backend backend = morph::Backend::Auto;
     WrinkleFrames frames = WrinkleFrames::Mesh;
+    // The keys must have been made in this layout's texture space.
+    WrinkleLayout layout = WrinkleLayout::Projective;
     // Beier-Neely parameters; normal_map is always set (the keys are normal maps).
     morph::MorphParams morph{};
     Material skin{};  // base_texture: the face's base colour unless set
@@ -101,6 +131,11 @@ public:
 
     // Draws the three meshes (options.wrinkles false: without the wrinkle map).
     void draw(const DrawOptions& options);
+    // Waits until the GL has done all it was given (glFinish): the draw's
+    // rasterisation (on llvmpipe, the CPU's threads) and, through interop,
+    // the CUDA morph the draw waits for. A clock read after it bills the
+    // draw what it cost, not only its submission.
+    void finish();
 
     // A frontal camera framing the face (neutral pose) for this aspect ratio.
     Camera frontal_camera(float aspect, float fovy_degrees = 20.0f) const;
@@ -112,6 +147,7 @@ public:
     int key_count() const;
     const expression::TriMesh& mesh() const { return mesh_; }
     const expression::FeatureLayout& layout() const { return layout_; }
+    WrinkleLayout layout_kind() const { return layout_kind_; }
     // L* as the morph takes it (one line per feature line), and its parameters.
     const morph::Layout& target_layout() const { return target_; }
     const morph::MorphParams& morph_params() const { return params_; }
@@ -122,13 +158,14 @@ public:
 private:
     struct Part;
     // Rig, wrinkle UVs, tangents, upload; and L* from the deformed feature
-    // points when asked.
+    // points when asked (projective layout; the anchored L* never moves).
     void deform(const expression::FapValues& faps, bool layout_from_mesh);
 
     Platform& platform_;
     const expression::Face& face_;
     const expression::FaceRig& rig_;
     expression::TextureBox box_;
+    WrinkleLayout layout_kind_;
     std::vector<expression::FeatureLine> lines_;
     expression::TriMesh mesh_;  // the posed full mesh
     expression::DeformedFace deformed_;

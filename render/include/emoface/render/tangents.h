@@ -5,10 +5,13 @@
 // orthogonalised against the normal (Gram-Schmidt); w holds the handedness, so
 // the shader rebuilds the bitangent as w * cross(N, T).
 //
-// The wrinkle map is sampled with UVs that change every frame (the projective
-// layout, DESIGN.md "Texture layouts"), so the frames are recomputed every
-// frame on the deformed mesh: TangentFrames keeps its buffers between calls
-// and does not allocate once the vertex count is stable.
+// The frames are recomputed every frame on the deformed mesh: the projective
+// layout's wrinkle UVs change every frame, and with the anchored layout's
+// fixed UVs the surface still bends (DESIGN.md "One frame"). TangentFrames
+// keeps its buffers between calls and does not allocate once the vertex
+// count is stable. UVs are taken as given, v down the image as the wrinkle
+// maps' rows run; a caller with OBJ-style UVs (v up) passes (u, 1 - v), or the
+// frames' bitangent points the opposite way of the maps' green.
 #include <cstddef>
 #include <vector>
 
@@ -33,7 +36,8 @@ public:
     // has no vertex normals.
     void compute(const expression::TriMesh& mesh, const std::vector<glm::vec2>& uvs);
 
-    // Same with the mesh's own per-vertex texcoords2D as the UV set.
+    // Same with the mesh's own per-vertex texcoords2D as the UV set, taken
+    // as stored (an OBJ's v runs up: its frames suit a map whose rows run up).
     void compute(const expression::TriMesh& mesh);
 
     const std::vector<glm::vec4>& tangents() const { return tangents_; }
