@@ -273,7 +273,10 @@ void FaceRig::build_point_field(const Face& face, double radius_scale) {
         const int src = fps_[k].vertex;
         const double o_fp = opening(neutral_[src][0]);
         if (o_fp <= 0) fail("expression: rig: the eye opening at feature point {} is closed", std::string(id));
-        const double fade = (upper ? 0.14 : 0.1) * es0 * radius_scale;
+        // The upper lid's skin folds under the brow as it rises or falls;
+        // the lower lid's skin moves as one sheet down to the cheek (AU6 and
+        // AU7 lift the infraorbital skin with the margin, where it bunches).
+        const double fade = (upper ? 0.14 : 0.17) * es0 * radius_scale;
         const int lid = static_cast<int>(lid_fps_.size());
         lid_fps_.push_back(k);
         for (auto [v, g] : graph.within({src}, 0.35 * es0 * radius_scale)) {
@@ -378,9 +381,15 @@ void FaceRig::build_eyes(const Face& face) {
         eyes_.push_back(std::move(e));
     }
     // Skin in front of an eyeball keeps at least its neutral clearance (the
-    // margins' at most), so a closing lid slides over the eye.
+    // margins' at most), so a closing lid slides over the eye; what a lid FAP
+    // carries also keeps its neutral distance from the eyeball's centre, so
+    // a lid turns about the eye (closing, the upper margin meets the lower
+    // one on the eyeball; opening, it slides back over it) instead of
+    // moving straight up or down off its surface.
     if (clearance > 1e29) return;
     clearance = std::max(clearance, 0.0);
+    std::vector<float> follow(neutral_.size(), 0.0f);
+    for (const LidWeight& lw : lid_weights_) follow[lw.vertex] = std::max(follow[lw.vertex], lw.weight);
     for (int v = 0; v < static_cast<int>(neutral_.size()); ++v) {
         if (parts_[v] != VertexPart::Skin) continue;
         for (std::size_t e = 0; e < eyes_.size(); ++e) {
@@ -388,7 +397,8 @@ void FaceRig::build_eyes(const Face& face) {
             const double r = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
             if (d[2] <= 0 || r > eyes_[e].radius * 1.8) continue;
             const double min_r = eyes_[e].radius + std::min(std::max(r - eyes_[e].radius, 0.0), clearance);
-            lid_vertices_.push_back({v, static_cast<int>(e), static_cast<float>(min_r)});
+            lid_vertices_.push_back(
+                {v, static_cast<int>(e), static_cast<float>(min_r), static_cast<float>(r), std::min(follow[v], 1.0f)});
         }
     }
 }
@@ -470,8 +480,13 @@ void FaceRig::deform(const FapValues& faps, DeformedFace& out) const {
             auto& p = pos[lv.vertex];
             const double dx = p[0] - e.centre[0], dy = p[1] - e.centre[1], dz = p[2] - e.centre[2];
             const double r2 = dx * dx + dy * dy + dz * dz, m2 = double(lv.min_radius) * lv.min_radius;
-            if (r2 >= m2 || dx * dx + dy * dy >= m2) continue;
-            p[2] = static_cast<float>(e.centre[2] + std::sqrt(m2 - dx * dx - dy * dy));
+            const double s2 = double(lv.shell_radius) * lv.shell_radius;
+            if (r2 < m2 && dx * dx + dy * dy < m2) {
+                p[2] = static_cast<float>(e.centre[2] + std::sqrt(m2 - dx * dx - dy * dy));
+            } else if (lv.follow > 0 && r2 > s2 && dx * dx + dy * dy < s2) {
+                const double shell_z = e.centre[2] + std::sqrt(s2 - dx * dx - dy * dy);
+                p[2] = static_cast<float>(p[2] + lv.follow * (shell_z - p[2]));
+            }
         }
     }
 

@@ -98,6 +98,8 @@ private:
         int vertex;
         int eye;
         float min_radius;
+        float shell_radius;  // neutral distance from the eyeball's centre
+        float follow;        // how much a lid FAP carries it (its largest lid weight)
     };
 
     void build_point_field(const Face& face, double radius_scale);

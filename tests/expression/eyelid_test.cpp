@@ -1,0 +1,115 @@
+// The eyelids measured on the deformed default face, in IRISD units (the
+// face's FAPU): where the lid margins cross the vertical through the iris
+// centre, against the iris's top and bottom edge as a frontal viewer sees
+// them. At rest the upper lid covers the top of the iris and the lower lid
+// meets its bottom (FIDELITY.md, "Iris cover at rest": no white above or
+// below the iris); AU5 bares white above it, AU6 and AU7 raise the lower
+// lid, AU43 closes the eye.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "emoface/expression/action_units.h"
+#include "emoface/expression/profiles.h"
+#include "test_face.h"
+
+namespace emoface::expression {
+namespace {
+
+using testing::test_face;
+using testing::test_rig;
+
+const ActionUnitTable& table() {
+    static const EmotionProfiles p = load_emotion_profiles(std::string(EMOFACE_DATA_DIR) + "/expression/emotions.json");
+    return p.action_units;
+}
+
+// y of a margin polyline (deformed positions) at x, linear between vertices.
+double margin_y_at(const std::vector<int>& margin, const std::vector<TriMesh::Point>& pos, double x) {
+    for (std::size_t i = 0; i + 1 < margin.size(); ++i) {
+        const auto a = pos[margin[i]], b = pos[margin[i + 1]];
+        if ((x - a[0]) * (x - b[0]) <= 0 && a[0] != b[0]) return a[1] + (x - a[0]) / (b[0] - a[0]) * (b[1] - a[1]);
+    }
+    ADD_FAILURE() << "x " << x << " is outside the margin";
+    return 0.0;
+}
+
+struct LidReading {
+    double upper_cover;   // iris top - upper margin (IRISD): > 0 the lid covers the iris
+    double lower_cover;   // lower margin - iris bottom (IRISD): >= 0 no white below the iris
+    double upper, lower;  // the margins' heights at the iris centre (IRISD)
+    double widest_gap;    // the largest upper - lower opening along the fissure (IRISD)
+    double below_lid;     // height of 3.9, the lower lid's skin (IRISD)
+};
+
+// Left eye (the right mirrors it; the AUs here are symmetric).
+LidReading read_lids(const FapValues& faps) {
+    const Face& face = test_face();
+    const DeformedFace out = test_rig().deform(faps);
+    const Eyeball& eb = face.eyeballs.at(0);
+    EXPECT_GT(eb.centre[0], 0.0);
+    const double irisd = face.fapu.irisd * 1024.0;
+    const double iris_r = eb.radius * std::sin(eb.iris_angle);
+    const double x = eb.centre[0];
+    LidReading r;
+    r.upper = margin_y_at(eb.upper_margin, out.positions, x) / irisd;
+    r.lower = margin_y_at(eb.lower_margin, out.positions, x) / irisd;
+    r.upper_cover = (eb.centre[1] + iris_r) / irisd - r.upper;
+    r.lower_cover = r.lower - (eb.centre[1] - iris_r) / irisd;
+    r.widest_gap = -1e9;
+    for (std::size_t i = 1; i + 1 < eb.upper_margin.size(); ++i) {
+        const auto u = out.positions[eb.upper_margin[i]];
+        r.widest_gap = std::max(r.widest_gap, (u[1] - margin_y_at(eb.lower_margin, out.positions, u[0])) / irisd);
+    }
+    r.below_lid = out.positions[face.feature_points[testing::fp("3.9")].vertex][1] / irisd;
+    return r;
+}
+
+FapValues au_faps(int au) {
+    const ActionUnit* u = table().find(au);
+    EXPECT_NE(u, nullptr) << "AU" << au;
+    return u ? u->faps : FapValues{};
+}
+
+TEST(Eyelids, MarginsSitOnTheIrisAtRestAndMoveWithTheLidAus) {
+    constexpr double kAny = 1e9;
+    struct Case {
+        const char* what;
+        int au;  // 0: neutral
+        // Bounds on the upper lid's cover of the iris top and the lower lid's
+        // cover of the iris bottom (IRISD).
+        double upper_min, upper_max, lower_min, lower_max;
+        // Least rise of the lower margin and of the skin below it (3.9)
+        // over neutral (IRISD).
+        double lower_rise_min, below_rise_min;
+        double widest_gap_max;  // AU43: the lids meet along the whole fissure
+    };
+    const Case cases[] = {
+        // 1-2 mm of iris under the upper lid; the lower lid at the limbus.
+        {"neutral", 0, 0.1, 0.2, 0.0, 0.1, -kAny, -kAny, kAny},
+        // The levator bares white above the iris; the lower lid stays.
+        {"AU5 upper lid raiser", 5, -kAny, -0.1, 0.0, 0.1, -0.02, -kAny, kAny},
+        // The orbital orbicularis lifts the lower lid and the skin below it.
+        {"AU6 cheek raiser", 6, 0.1, kAny, 0.1, kAny, 0.08, 0.08, kAny},
+        // The palpebral orbicularis raises and tightens the lower lid over the iris.
+        {"AU7 lid tightener", 7, 0.1, kAny, 0.1, kAny, 0.1, -kAny, kAny},
+        // The upper lid comes down onto the lower one all along.
+        {"AU43 eyes closed", 43, 0.9, kAny, 0.0, kAny, -0.02, -kAny, 0.05},
+    };
+    const LidReading rest = read_lids(FapValues{});
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.what);
+        const LidReading r = c.au == 0 ? rest : read_lids(au_faps(c.au));
+        EXPECT_GE(r.upper_cover, c.upper_min);
+        EXPECT_LE(r.upper_cover, c.upper_max);
+        EXPECT_GE(r.lower_cover, c.lower_min);
+        EXPECT_LE(r.lower_cover, c.lower_max);
+        EXPECT_GE(r.lower - rest.lower, c.lower_rise_min);
+        EXPECT_GE(r.below_lid - rest.below_lid, c.below_rise_min);
+        EXPECT_LE(r.widest_gap, c.widest_gap_max);
+    }
+}
+
+}  // namespace
+}  // namespace emoface::expression
