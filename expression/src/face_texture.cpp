@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdint>
 
+#include "eye_texture.h"
+
 namespace emoface::expression::detail {
 namespace {
 
@@ -117,16 +119,48 @@ bool Painter::hair(V3 q, double* amount) const {
     return *amount > 0.0;
 }
 
+// Redness: haemoglobin absorbs green and blue, so a redder patch keeps its
+// red and loses some of both. `amount` 1 is the strongest flush painted.
+Rgb redden(Rgb c, double amount) {
+    return blend(c, c * Rgb{1.02, 0.83, 0.85}, std::clamp(amount, 0.0, 1.5));
+}
+// A soft elliptical field, 1 at (cx, cy) falling off as a Gaussian of
+// widths sx, sy (mm): regions of colour with no edge to see.
+double field(double x, double y, double cx, double cy, double sx, double sy) {
+    const double dx = (x - cx) / sx, dy = (y - cy) / sy;
+    return std::exp(-0.5 * (dx * dx + dy * dy));
+}
+
 Rgb Painter::skin(V3 q) const {
     const Rgb skin = from255(p_.skin);
-    Rgb c = skin * (0.95 + 0.1 * fbm(q.x * 0.12, q.y * 0.12, q.z * 0.12));
+    // Gentle pigment variation at two scales (MATTS: even skin reads young,
+    // so it stays within a few percent), and haemoglobin mottling apart from
+    // it so the two do not move together.
+    Rgb c = skin * (0.96 + 0.08 * fbm(q.x * 0.08, q.y * 0.08, q.z * 0.08));
+    c = redden(c, 0.35 * (fbm(q.x * 0.21 + 11.0, q.y * 0.21, q.z * 0.21) - 0.45));
     const double ax = std::abs(q.x);
     const bool front = q.z > 45.0;
     if (front) {
-        // Warmer cheeks, nose tip and ear-side.
-        const double cheek = 1.0 - smoothstep(0.0, 1.0, std::hypot(ax - 40.0, q.y + 30.0) / 26.0);
-        const double nose = 1.0 - smoothstep(0.0, 1.0, std::hypot(q.x, q.y + 38.0) / 14.0);
-        c = blend(c, c * Rgb{1.06, 0.86, 0.86}, 0.55 * cheek + 0.35 * nose);
+        // Regional redness (HAN, XIAO: the cheek is the reddest site; the
+        // nose and chin are flushed; the forehead is the darkest and least
+        // red). Broad Gaussian fields, their strength broken up by noise, so
+        // they read as blood under skin, not as painted discs.
+        const double blotch = 0.75 + 0.5 * noise(q.x * 0.15, q.y * 0.15, 4.0);
+        const double cheek = field(ax, q.y, 40.0, -26.0, 17.0, 15.0);
+        const double nose = field(q.x, q.y, 0.0, -36.0, 8.0, 9.0) + 0.5 * field(ax, q.y, 11.0, -41.0, 5.0, 5.0);
+        const double chin = field(q.x, q.y, 0.0, -96.0, 14.0, 9.0);
+        c = redden(c, blotch * (0.55 * cheek + 0.5 * nose + 0.22 * chin));
+        // Forehead: a shade darker and more yellow.
+        const double forehead = smoothstep(18.0, 45.0, q.y);
+        c = blend(c, c * Rgb{0.97, 0.955, 0.92}, 0.8 * forehead);
+
+        // Beard zone (shaved): a bluish-grey cast from the stubble under the
+        // skin, over the upper lip, chin, jaw and lower cheeks, below a line
+        // from the sideburn to the mouth corner, fading on the neck.
+        const double cheek_line = ax < 28.0 ? -46.0 : mix(-46.0, -14.0, std::min((ax - 28.0) / 34.0, 1.0));
+        const double beard = smoothstep(2.0, -10.0, q.y - cheek_line) * smoothstep(-150.0, -118.0, q.y) *
+                             (0.8 + 0.4 * noise(q.x * 1.7, q.y * 1.7, q.z * 1.7));
+        c = blend(c, c * Rgb{0.84, 0.88, 0.97}, 0.38 * beard);
 
         // Lips.
         const double hw = s_.mouth_half_width();
@@ -175,6 +209,9 @@ Rgb Painter::skin(V3 q) const {
         const double n = s_.nostril_amount(q.x, q.y);
         if (n > 0) c = blend(c, Rgb{0.25, 0.12, 0.11}, smoothstep(0.05, 0.5, n));
     }
+    // Ears: thin, well perfused, redder than the face beside them.
+    if (ax > 55.0 && s_.ear_relief(q.y, q.z) > 0.0)
+        c = redden(c, 0.45 * std::min(1.0, s_.ear_relief(q.y, q.z) / 3.0));
     double h = 0;
     if (hair(q, &h)) {
         const Rgb hc = from255(p_.hair) *
@@ -191,19 +228,10 @@ Rgb Painter::tile(double u, double v) const {
     const double beta = std::atan2(lv - 0.5, lu - 0.5);
     switch (static_cast<Tile>(t)) {
         case Tile::Eye: {
-            const double a = r * kPi;
-            const double ai = std::asin(p_.iris_radius / p_.eye_radius);
-            const double ap = std::asin(p_.pupil_radius / p_.eye_radius);
-            const Rgb sclera = from255(p_.sclera) * (1.0 - 0.18 * smoothstep(0.25 * kPi, 0.8 * kPi, a));
-            if (a > ai + 0.02) return sclera;
-            const double tt = (a - ap) / (ai - ap);
-            const double streak = noise(beta * 14.0, tt * 3.0, 5.0);
-            Rgb iris = from255(p_.iris) * (0.7 + 0.6 * streak);
-            iris = iris * (1.0 - 0.65 * smoothstep(0.78, 1.0, tt));            // dark limbal ring
-            iris = blend(iris, iris * 1.35, std::exp(-std::pow((tt - 0.28) / 0.08, 2)));  // collarette
-            if (a > ai) return blend(iris, sclera, (a - ai) / 0.02);
-            if (a < ap) return Rgb{0.015, 0.015, 0.018};
-            return blend(Rgb{0.015, 0.015, 0.018}, iris, smoothstep(0.0, 0.06, tt));
+            // The tile's corners, outside the eyeball's disc, hold the lashes' colour.
+            if (r > 1.1) return from255(p_.lashes);
+            const auto c = eye_colour(s_, r * kPi, beta);
+            return {c[0], c[1], c[2]};
         }
         case Tile::Cavity:
             return from255(p_.mouth) * (0.3 + 0.7 * std::min(r, 1.0));
