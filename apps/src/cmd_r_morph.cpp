@@ -20,6 +20,7 @@
 
 #include "command.h"
 #include "emoface/common/error.h"
+#include "emoface/common/timing.h"
 #include "emoface/expression/emotion.h"
 #include "emoface/morph/morph.h"
 #include "session.h"
@@ -29,11 +30,6 @@ namespace {
 
 using namespace emoface;
 using namespace emoface::apps;
-
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 struct MorphArgs {
     std::string from = "anger", to = "surprise", out;
@@ -131,7 +127,9 @@ void run_morph(const MorphArgs& a) {
         bn.captions.push_back(caption);
 
         auto& platform = session.platform();
-        const auto draw = session.draw_options(1.0f);
+        // Figure 6.4 is drawn with the thesis's Blinn-Phong.
+        auto draw = session.draw_options(1.0f);
+        draw.shading = render::Shading::Thesis;
         auto b0 = Clock::now();
         platform.begin_frame();
         session.draw(draw);
