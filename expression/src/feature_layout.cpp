@@ -8,6 +8,7 @@
 
 #include <glm/geometric.hpp>
 #include <glm/mat3x3.hpp>
+#include <glm/vector_relational.hpp>
 #include <nlohmann/json.hpp>
 
 #include "emoface/common/error.h"
@@ -70,24 +71,33 @@ FeatureLayout anchored_layout(const std::array<glm::vec2, kFeatureCount>& uvs,
 namespace {
 
 // The UV (v up) the skin around `position` gives it: the least-squares affine
-// map (x, y) -> (u, v) of the nearest skin vertices, evaluated at position.
+// map (x, y) -> (u, v) of the nearest feature points on skin vertices,
+// evaluated at position. Feature points, not any skin vertices: those lie on
+// the face's UV island by definition, while skin vertices near an off-skin
+// point (inside the lids, around the mouth's interior) may be mapped to
+// other parts of an atlas.
 glm::vec2 skin_uv_at(const Face& face, const Vec3d& position) {
-    constexpr std::size_t kNeighbours = 12;
+    constexpr std::size_t kNeighbours = 8;
     const glm::dvec3 p(position[0], position[1], position[2]);
     std::vector<std::pair<double, int>> near;
-    for (const auto vh : face.mesh.vertices()) {
-        if (face.parts[std::size_t(vh.idx())] != VertexPart::Skin) continue;
-        const auto& q = face.mesh.point(vh);
+    for (const FeaturePointLocation& fp : face.feature_points) {
+        if (!fp.present || fp.vertex < 0 || face.parts[std::size_t(fp.vertex)] != VertexPart::Skin) continue;
+        const auto& q = face.mesh.point(TriMesh::VertexHandle(fp.vertex));
         const glm::dvec3 d = glm::dvec3(q[0], q[1], q[2]) - p;
-        near.emplace_back(glm::dot(d, d), vh.idx());
+        near.emplace_back(glm::dot(d, d), fp.vertex);
     }
+    if (near.empty())
+        fail<InputError>("expression: face '{}': no feature point lies on a skin vertex, so the anchored "
+                         "layout has no UVs to place the others by",
+                         face.name);
     const std::size_t k = std::min(kNeighbours, near.size());
     std::partial_sort(near.begin(), near.begin() + std::ptrdiff_t(k), near.end());
     // Normal equations of [x y 1] * A = [u v], centred on `position` so the
     // answer is the constant term.
     glm::dmat3 ata(0.0);
     glm::dvec3 atu(0.0), atv(0.0);
-    glm::dvec2 mean(0.0);
+    glm::dvec2 mean(0.0), lo(1e30), hi(-1e30);
+    double mean_weight = 0.0;
     for (std::size_t i = 0; i < k; ++i) {
         const auto vh = TriMesh::VertexHandle(near[i].second);
         const auto& q = face.mesh.point(vh);
@@ -96,17 +106,30 @@ glm::vec2 skin_uv_at(const Face& face, const Vec3d& position) {
         ata += glm::outerProduct(row, row);
         atu += row * double(t[0]);
         atv += row * double(t[1]);
-        mean += glm::dvec2(t[0], t[1]) / double(k);
+        // The fallback: inverse-distance weighted mean of their UVs.
+        const double w = 1.0 / (std::sqrt(near[i].first) + 1e-9);
+        mean += w * glm::dvec2(t[0], t[1]);
+        mean_weight += w;
+        lo = glm::min(lo, glm::dvec2(t[0], t[1]));
+        hi = glm::max(hi, glm::dvec2(t[0], t[1]));
     }
+    mean /= mean_weight;
     // Neighbours (nearly) on a line in the frontal view fix no affine map:
-    // their mean UV. ata's upper 2x2 less the mean's part is k times the
+    // their weighted mean UV. ata's upper 2x2 less the mean's part is k times the
     // covariance of their x, y.
     const double n = double(k);
     const double cxx = ata[0][0] - ata[2][0] * ata[2][0] / n, cyy = ata[1][1] - ata[2][1] * ata[2][1] / n,
                  cxy = ata[1][0] - ata[2][0] * ata[2][1] / n;
     if (k < 3 || !(cxx * cyy - cxy * cxy > 1e-6 * (cxx + cyy) * (cxx + cyy))) return glm::vec2(mean);
     const glm::dmat3 inv = glm::inverse(ata);
-    return glm::vec2(float((inv * atu).z), float((inv * atv).z));
+    const glm::dvec2 fit((inv * atu).z, (inv * atv).z);
+    // Neighbours whose UVs do not follow their positions (a seam, lid
+    // margins folded into the socket) make the fit extrapolate wildly: keep
+    // it only where it stays near their UVs.
+    const glm::dvec2 reach = 0.5 * (hi - lo);
+    if (glm::any(glm::lessThan(fit, lo - reach)) || glm::any(glm::greaterThan(fit, hi + reach)))
+        return glm::vec2(mean);
+    return glm::vec2(fit);
 }
 
 }  // namespace

@@ -69,11 +69,13 @@ struct Face;
 // (7.1 inside the neck) has no UV of the skin, yet the wrinkles are placed
 // from it (the pupils set the face unit): it gets the UV the skin around it
 // would give it, an affine map from frontal position (x, y) to UV fitted by
-// least squares to the nearest skin vertices. This assumes the skin's UVs are
-// one upright island around the face (the brows above the eyes, the face's
-// left to the image's right), which is what painting wrinkles across the
-// glabella needs anyway. Throws emoface::InputError naming the face when the
-// mesh has no UVs, or the feature points' UVs span no area.
+// least squares to the nearest feature points on skin vertices (their
+// distance-weighted mean UV where that fit strays far outside their UVs).
+// This assumes the skin's UVs are one upright island around the face (the
+// brows above the eyes, the face's left to the image's right), which is what
+// painting wrinkles across the glabella needs anyway. Throws
+// emoface::InputError naming the face when the mesh has no UVs, or the
+// feature points' UVs span no area.
 FeatureLayout anchored_layout(const Face& face);
 
 // A layout as JSON, so a painted key map can come with its own layout:
