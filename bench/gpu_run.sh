@@ -22,5 +22,5 @@ timeout 330 $run/morph --sizes 256,1024,4096 --lines 40,84,100 --keys 2,7 --back
   --fast-cells 8,16 --fast-reach 4 --runs 50 --out "$out/bench_full.md" 2>"$out/bench_full.err"
 tail -3 "$out/bench_full.err"
 echo "== bench: CPU, 2 threads on this host"
-EMOFACE_MORPH_THREADS=2 timeout 120 $run/morph --sizes 256,512 --lines 84 --keys 2,7 --backends cpu \
+EMOFACE_THREADS=2 timeout 120 $run/morph --sizes 256,512 --lines 84 --keys 2,7 --backends cpu \
   --fast-cells 8 --fast-reach 1,4 --runs 50 --cpu-budget 10 --out "$out/bench_cpu2.md" 2>/dev/null | grep "^|"

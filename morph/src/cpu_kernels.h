@@ -194,7 +194,7 @@ void fast_tiles_t(const CpuJob& job, int t0, int t1) {
     const int C = plan.fast_cell;
     const float inv_c = 1.0f / static_cast<float>(C);
     const float inv = plan.inv_extent;
-    const kernel::FastGrid grid{plan.records, plan.record_floats, plan.lines, job.grid, job.grid_w, S, C, inv,
+    const kernel::FastGrid grid{plan.records, plan.record_floats, plan.lines, job.grid, job.grid_w, S, C, inv_c, inv,
                                 kernel::cell_reach(plan.fast_reach, C, inv), plan.b};
     const int tiles_w = (job.width + C - 1) / C;
     unsigned short list[kernel::kMaxNear];

@@ -81,6 +81,7 @@ struct KernelArgs {
     // Fast mode: grid sums, and per cell its near lines.
     const float* grid;
     int grid_w, cell, tiles_w, tiles_h;
+    float inv_cell;
     float reach;  // iso units, from a cell's centre
     int* near_count;
     unsigned short* near_list;  // [cell][kernel::kMaxNear]
@@ -122,6 +123,7 @@ __device__ EMOFACE_INLINE kernel::FastGrid fast_grid(const KernelArgs& a, const 
             a.grid_w,
             sums_stride(K),
             a.cell,
+            a.inv_cell,
             a.inv_extent,
             a.reach,
             a.b};
@@ -243,7 +245,7 @@ __global__ void __launch_bounds__(256, 3) apply_kernel(const __grid_constant__ K
     const float inv = a.inv_extent;
     const float xi = (static_cast<float>(x0) + 0.5f) * inv, yi = (static_cast<float>(y) + 0.5f) * inv;
     const bool crowded = count > kernel::kMaxNear;  // every line, exactly
-    const float inv_cell = 1.0f / static_cast<float>(a.cell);
+    const float inv_cell = a.inv_cell;
 
     // The cell's corner sums (from the grid, or from pass 2 where the cell
     // has near lines), its two columns interpolated to this row.
@@ -429,6 +431,7 @@ public:
         } else {
             const int cell = plan.fast_cell;
             a.cell = cell;
+            a.inv_cell = 1.0f / static_cast<float>(cell);
             a.grid_w = (width_ - 1) / cell + 2;
             const int grid_h = (height_ - 1) / cell + 2;
             a.tiles_w = (width_ + cell - 1) / cell;

@@ -45,23 +45,9 @@ class MorphCudaParity : public ::testing::TestWithParam<ParityCase> {};
 TEST_P(MorphCudaParity, CudaAgreesWithTheCpu) {
     SKIP_WITHOUT_CUDA();
     const ParityCase& c = GetParam();
-    std::vector<std::vector<std::uint8_t>> bytes;
-    std::vector<std::vector<float>> floats;
-    std::vector<KeyMap> keys;
     const Layout base = random_layout(c.lines, 7);
-    for (int k = 0; k < c.keys; ++k) {
-        if (c.normal_map)
-            floats.push_back(random_normals(c.width, c.height, 10 + k));
-        else
-            floats.push_back(to_float(random_rgba8(c.width, c.height, 10 + k)));
-        bytes.push_back(quantise(floats.back()));
-    }
-    for (int k = 0; k < c.keys; ++k) {
-        KeyMap key;
-        key.pixels = c.format == PixelFormat::Rgba8 ? static_cast<const void*>(bytes[k].data()) : floats[k].data();
-        key.layout = jitter(base, 0.05f, 20 + k);
-        keys.push_back(key);
-    }
+    const RandomKeys random = random_keys(c.width, c.height, c.keys, c.format, c.normal_map, base, 10);
+    const std::vector<KeyMap>& keys = random.keys;
     const Layout target = jitter(base, 0.04f, 30);
     std::vector<float> weights(c.keys, 0.0f);
     const int nonzero = c.keys - (c.zero_weight >= 0 ? 1 : 0);

@@ -490,20 +490,9 @@ struct CpuPathCase {
 
 void check_cpu_paths(const CpuPathCase& c, const MorphParams& params) {
     const bool is_float = c.format == PixelFormat::RgbaF32;
-    std::vector<std::vector<float>> float_keys;
-    std::vector<std::vector<std::uint8_t>> byte_keys;
-    std::vector<KeyMap> keys;
     const Layout base = random_layout(c.lines, 201);
-    for (int k = 0; k < c.keys; ++k) {
-        if (params.normal_map)
-            float_keys.push_back(random_normals(c.width, c.height, 210 + k));
-        else
-            float_keys.push_back(to_float(random_rgba8(c.width, c.height, 210 + k)));
-        byte_keys.push_back(quantise(float_keys.back()));
-    }
-    for (int k = 0; k < c.keys; ++k)
-        keys.push_back(key(is_float ? static_cast<const void*>(float_keys[k].data()) : byte_keys[k].data(),
-                           jitter(base, 0.06f, 220 + k)));
+    const RandomKeys random = random_keys(c.width, c.height, c.keys, c.format, params.normal_map, base, 210);
+    const std::vector<KeyMap>& keys = random.keys;
     const Layout target = jitter(base, 0.04f, 230);
     std::vector<float> weights(c.keys, 1.0f / c.keys);
     const std::size_t values = static_cast<std::size_t>(c.width) * c.height * 4;

@@ -85,6 +85,32 @@ inline Layout jitter(const Layout& base, float amount, unsigned seed) {
     return l;
 }
 
+// K random key maps of one size in both encodings (unit normals when
+// normal_map), with layouts jittered from `base`; each KeyMap points at the
+// pixels of `format`. The pixels live here, beside the KeyMaps that point at
+// them.
+struct RandomKeys {
+    std::vector<std::vector<float>> floats;
+    std::vector<std::vector<std::uint8_t>> bytes;
+    std::vector<KeyMap> keys;
+};
+
+inline RandomKeys random_keys(int w, int h, int count, PixelFormat format, bool normal_map, const Layout& base,
+                              unsigned seed) {
+    RandomKeys r;
+    for (int k = 0; k < count; ++k) {
+        r.floats.push_back(normal_map ? random_normals(w, h, seed + k) : to_float(random_rgba8(w, h, seed + k)));
+        r.bytes.push_back(quantise(r.floats.back()));
+    }
+    for (int k = 0; k < count; ++k) {
+        KeyMap key;
+        key.pixels = format == PixelFormat::Rgba8 ? static_cast<const void*>(r.bytes[k].data()) : r.floats[k].data();
+        key.layout = jitter(base, 0.05f, seed + 10 + k);
+        r.keys.push_back(key);
+    }
+    return r;
+}
+
 template <class T>
 inline double max_abs_diff(const std::vector<T>& a, const std::vector<T>& b) {
     double m = 0.0;

@@ -249,6 +249,7 @@ struct FastGrid {
     int grid_w;
     int stride;
     int cell;
+    float inv_cell;  // 1 / cell, divided once by the backend
     float inv_extent;
     float reach;  // cell_reach()
     float b;
@@ -326,13 +327,17 @@ EMOFACE_HD EMOFACE_INLINE void cell_corner_sums(const FastGrid& g, const unsigne
         for (int n = 0; n < count; ++n)
             accumulate_line<K, 1, L>(g.records + list[n] * g.record_floats, grid_coord(gx, g.cell, g.inv_extent),
                                      grid_coord(gy, g.cell, g.inv_extent), 0.0f, g.b, near);
-        float* far = out + c * out_stride;
+        // Into registers first: `out` may be global memory that the compiler
+        // cannot prove apart from the grid, and a store before each load
+        // would serialise them.
+        float far[sum_floats(K)];
         far[0] = all[0] - near.w[0];
         EMOFACE_UNROLL
         for (int k = 0; k < K; ++k) {
             far[1 + 2 * k] = all[1 + 2 * k] - near.dx[k][0];
             far[2 + 2 * k] = all[2 + 2 * k] - near.dy[k][0];
         }
+        for (int q = 0; q < sum_floats(K); ++q) out[c * out_stride + q] = far[q];
     }
 }
 
@@ -350,10 +355,9 @@ EMOFACE_HD EMOFACE_INLINE void cell_run(const FastGrid& g, const unsigned short*
             accumulate_line<K, R, L>(g.records + l * g.record_floats, x, y, g.inv_extent, g.b, acc);
         return;
     }
-    const float inv_cell = 1.0f / static_cast<float>(g.cell);
     EMOFACE_PIXEL_LOOP
     for (int j = 0; j < R; ++j) {
-        const float fx = static_cast<float>(i0 + j) * inv_cell;
+        const float fx = static_cast<float>(i0 + j) * g.inv_cell;
         acc.w[j] = left[0] + fx * (right[0] - left[0]);
         EMOFACE_UNROLL
         for (int k = 0; k < K; ++k) {
