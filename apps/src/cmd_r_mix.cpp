@@ -2,7 +2,6 @@
 // contact sheet of the mix at intensities 0, 0.25, 0.5, 0.75 and 1.
 //   emoface mix "0.7 anger + 0.3 fear" --out face.png
 //   emoface mix surprise --sheet --out surprise_sheet.png
-#include <cstdlib>
 #include <memory>
 #include <string>
 
@@ -25,6 +24,7 @@ struct MixArgs {
     std::string mix, out, size;
     bool sheet = false, normalise = false;
     SessionArgs session;
+    ViewerOptions viewer;  // without --out
 };
 
 constexpr double kSheetIntensities[] = {0.0, 0.25, 0.5, 0.75, 1.0};
@@ -38,24 +38,14 @@ expression::EmotionMix scaled(const expression::EmotionMix& mix, double s) {
 void run_mix(const MixArgs& a) {
     const expression::EmotionMix mix = expression::parse_emotion_mix(a.mix, a.normalise);
     if (a.out.empty()) {
-        const char* display = std::getenv("DISPLAY");
-        if (!display || !*display)
-            fail<EnvironmentError>("mix: no display for the viewer (DISPLAY is not set): give --out "
-                                   "face.png to write a picture");
-#ifdef EMOFACE_HAVE_VIEWER
-        ViewerOptions v;
-        if (!a.size.empty()) std::tie(v.width, v.height) = parse_size(a.size, "mix");
-        const SessionOptions so = a.session.resolve("mix", v.width, v.height);
-        v.face = so.face;
-        v.fdp = so.fdp;
+        // The viewer, its sliders at the mix, with every session option given.
+        ViewerOptions v = a.viewer;
+        v.command = "mix";
         v.mix = mix.to_string();
-        v.backend = so.backend;
-        v.wrinkles = so.wrinkles;
+        const auto [width, height] = parse_size(a.size.empty() ? "1280x720" : a.size, "mix");
+        v.session = a.session.resolve("mix", width, height);
         run_viewer(v);
         return;
-#else
-        fail<EnvironmentError>("mix: this build has no viewer: give --out face.png");
-#endif
     }
     const auto [width, height] = parse_size(a.size.empty() ? (a.sheet ? "320x320" : "720x720") : a.size, "mix");
     const SessionOptions so = a.session.resolve("mix", width, height);
@@ -64,8 +54,8 @@ void run_mix(const MixArgs& a) {
 
     if (!a.sheet) {
         render::write_image(a.out, session.render_frame(session.face_state(mix)));
-        fmt::print("mix: wrote {} ({}x{}, {}{})\n", a.out, width, height, mix.to_string(),
-                   so.wrinkles ? "" : ", without wrinkles");
+        fmt::print("mix: wrote {} ({}x{}, {}{})\n", a.out, so.picture_width(), height, mix.to_string(),
+                   so.wrinkles_note());
     } else {
         SheetRow row;
         for (double s : kSheetIntensities) {
@@ -89,12 +79,15 @@ void add_mix_command(CLI::App& root) {
                     "Emotion mix: \"0.7 anger + 0.3 fear\", \"joy=0.5, surprise=0.2\", \"sadness\" (joy, "
                     "sadness, anger, fear, disgust, surprise; weights sum to at most 1)")
         ->required();
-    sub->add_option("-o,--out", a->out, "Output image (.png, .jpg, .exr, ...)");
+    CLI::Option* out =
+        sub->add_option("-o,--out", a->out, "Output image (.png, .jpg, .exr, ...); without it: the viewer");
     sub->add_flag("--sheet", a->sheet, "A contact sheet of the mix at intensities 0, 0.25, 0.5, 0.75, 1");
     sub->add_flag("--normalise", a->normalise, "Scale a mix summing over 1 down to 1");
     sub->add_option("--size", a->size, "Picture (or sheet tile) size WIDTHxHEIGHT (default 720x720; "
-                                       "320x320 a tile with --sheet)");
+                                       "320x320 a tile with --sheet; 1280x720 the viewer's window)");
     add_session_options(*sub, a->session);
+    add_side_by_side_option(*sub, a->session);
+    add_viewer_options(*sub, a->viewer, out);
     sub->callback([a] { run_mix(*a); });
 }
 

@@ -27,32 +27,38 @@ struct PlayArgs {
     std::string fap, out, size = "1280x720", frames;
     double fps = 0;
     SessionArgs session;
+    ViewerOptions viewer;  // without --out
 };
 
 // The frames [first, end) of a --frames A:B slice of `count` frames. B is
 // exclusive (as in Python), so 0:50 and 50:107 together are 0:107 = all;
-// either side may be left out (":50", "50:").
+// either side may be left out (":50", "50:"). Messages quote the user's
+// text ('60:') so it never runs into the message's own colon.
 std::pair<int, int> parse_slice(const std::string& text, int count) {
     if (text.empty()) return {0, count};
     const auto colon = text.find(':');
     if (colon == std::string::npos || text.find(':', colon + 1) != std::string::npos)
         fail<InputError>("play: --frames '{}': expected A:B (first frame, end frame exclusive), "
-                         "e.g. 0:50",
+                         "e.g. 0:50, 50: or :50",
                          text);
     auto number = [&](const std::string& part, int fallback) {
         if (part.empty()) return fallback;
-        char* end = nullptr;
-        const long v = std::strtol(part.c_str(), &end, 10);
-        if (*end != '\0' || part.find_first_not_of("0123456789") != std::string::npos)
-            fail<InputError>("play: --frames '{}': '{}' is not a frame number", text, part);
-        return int(std::min<long>(v, 1L << 30));
+        if (part.find_first_not_of("0123456789") != std::string::npos || part.size() > 9)
+            fail<InputError>("play: --frames '{}': expected A:B of frame numbers, '{}' is not one", text,
+                             part);
+        return std::stoi(part);
     };
     const int a = number(text.substr(0, colon), 0);
     const int b = number(text.substr(colon + 1), count);
-    if (a >= b || b > count)
-        fail<InputError>("play: --frames {}: the animation has frames 0..{} (end exclusive: "
-                         "A < B <= {})",
-                         text, count - 1, count);
+    const std::string frames = fmt::format("the animation has frames 0..{}", count - 1);
+    if (a >= count)
+        fail<InputError>("play: --frames '{}': first frame {} is past the end ({})", text, a, frames);
+    if (b > count)
+        fail<InputError>("play: --frames '{}': end {} is past the end ({}; the end is exclusive, so at "
+                         "most {})",
+                         text, b, frames, count);
+    if (a >= b)
+        fail<InputError>("play: --frames '{}': expected A < B (the end frame B is exclusive)", text);
     return {a, b};
 }
 
@@ -88,27 +94,14 @@ fap::FapFrame frame_at(const fap::FapStream& resolved, double fps, int i) {
     return two.sample((position - double(k)) / resolved.fps);
 }
 
+// The viewer on the file, with every session option given.
 void run_viewer_for(const PlayArgs& a) {
-    const char* display = std::getenv("DISPLAY");
-    const char* wayland = std::getenv("WAYLAND_DISPLAY");
-    if ((!display || !*display) && (!wayland || !*wayland))
-        fail<EnvironmentError>("play: no display for the viewer (DISPLAY is not set): give --out "
-                               "out.mp4 to render headless, or run it under a desktop or xvfb-run");
-#ifdef EMOFACE_HAVE_VIEWER
-    const auto [width, height] = parse_size(a.size, "play");
-    const SessionOptions so = a.session.resolve("play", width, height);
-    ViewerOptions v;
+    ViewerOptions v = a.viewer;
+    v.command = "play";
     v.fap_path = a.fap;
-    v.face = so.face;
-    v.fdp = so.fdp;
-    v.backend = so.backend;
-    v.width = width;
-    v.height = height;
-    v.wrinkles = so.wrinkles;
+    const auto [width, height] = parse_size(a.size, "play");
+    v.session = a.session.resolve("play", width, height);
     run_viewer(v);
-#else
-    fail<EnvironmentError>("play: this build has no viewer: give --out out.mp4 to render headless");
-#endif
 }
 
 void run_play(const PlayArgs& a) {
@@ -122,7 +115,6 @@ void run_play(const PlayArgs& a) {
     const auto [width, height] = parse_size(a.size, "play");
     const SessionOptions so = a.session.resolve("play", width, height);
     const OutKind kind = output_kind(a.out);
-    check_output_folder(a.out, "play");
     if (kind == OutKind::Video && (width % 2 || height % 2))
         fail<InputError>("play: --size {}: a video needs an even width and height", a.size);
 
@@ -131,6 +123,8 @@ void run_play(const PlayArgs& a) {
                           ? std::max(1, int(std::lround(double(stream.frames.size()) * fps / stream.fps)))
                           : int(stream.frames.size());
     const auto [first, end] = parse_slice(a.frames, count);
+    // Last of the checks: it makes a missing output folder.
+    check_output_folder(a.out, "play");
     const fap::FapStream resolved = fap::resolve_untransmitted(stream);
 
     Session session(so);
@@ -138,7 +132,7 @@ void run_play(const PlayArgs& a) {
     std::unique_ptr<render::VideoWriter> video;
     std::unique_ptr<render::FrameSequenceWriter> sequence;
     if (kind == OutKind::Video)
-        video = std::make_unique<render::VideoWriter>(a.out, width, height, fps);
+        video = std::make_unique<render::VideoWriter>(a.out, so.picture_width(), height, fps);
     else
         sequence = std::make_unique<render::FrameSequenceWriter>(a.out, first);
 
@@ -157,12 +151,12 @@ void run_play(const PlayArgs& a) {
     if (video) {
         const std::string codec = video->codec();
         const std::string path = video->close();
-        fmt::print("play: wrote {}: {} frames{} {}x{} at {:g} frames/s, {}{}\n", path, end - first, slice,
-                   width, height, fps, codec == "H.264" ? "H.264 MP4" : "Motion-JPEG AVI",
-                   path != a.out ? " (OpenCV has no H.264 encoder here)" : "");
+        fmt::print("play: wrote {}: {} frames{} {}x{} at {:g} frames/s, {}{}{}\n", path, end - first, slice,
+                   so.picture_width(), height, fps, codec == "H.264" ? "H.264 MP4" : "Motion-JPEG AVI",
+                   so.wrinkles_note(), path != a.out ? " (OpenCV has no H.264 encoder here)" : "");
     } else {
-        fmt::print("play: wrote {} .. {}: {} frames{} {}x{}\n", sequence->path_for(first),
-                   sequence->path_for(end - 1), end - first, slice, width, height);
+        fmt::print("play: wrote {} .. {}: {} frames{} {}x{}{}\n", sequence->path_for(first),
+                   sequence->path_for(end - 1), end - first, slice, so.picture_width(), height, so.wrinkles_note());
     }
     fmt::print("play: {}\n{}", session.description(),
                format_times(session.load_times(), session.frame_totals()));
@@ -175,7 +169,7 @@ void add_play_command(CLI::App& root) {
         "the viewer");
     auto a = std::make_shared<PlayArgs>();
     sub->add_option("file", a->fap, "MPEG-4 FAP file (.fap)")->required();
-    sub->add_option("-o,--out", a->out,
+    CLI::Option* out = sub->add_option("-o,--out", a->out,
                     "Video (.mp4: H.264 where OpenCV can, else Motion-JPEG .avi; .avi) or frame "
                     "pattern (frames/%04d.png, numbered by frame). Without it: the viewer");
     sub->add_option("--size", a->size, "Frame size WIDTHxHEIGHT")->capture_default_str();
@@ -184,6 +178,8 @@ void add_play_command(CLI::App& root) {
                     "Render the slice A:B of the output frames, B exclusive (0:50 then 50:107 "
                     "together make 0:107); frame patterns are numbered by frame");
     add_session_options(*sub, a->session);
+    add_side_by_side_option(*sub, a->session);
+    add_viewer_options(*sub, a->viewer, out);
     sub->callback([a] { run_play(*a); });
 }
 

@@ -25,8 +25,7 @@ struct WrinklesArgs {
 };
 
 void run_wrinkles(const WrinklesArgs& args) {
-    if (args.size < 256 || args.size > 4096)
-        fail<InputError>("wrinkles: --size must be 256..4096, found {}", args.size);
+    render::check_wrinkle_map_size(args.size, "wrinkles: --size");
     namespace fs = std::filesystem;
     std::error_code ec;
     if (fs::exists(args.out, ec) && !fs::is_directory(args.out, ec))

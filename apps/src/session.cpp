@@ -3,9 +3,9 @@
 #include "emoface/render/wrinkle_keys_io.h"
 
 #include <algorithm>
-#include <bitset>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 
 #include <CLI/CLI.hpp>
@@ -15,7 +15,7 @@
 #include <spdlog/spdlog.h>
 
 #include "emoface/common/error.h"
-#include "emoface/common/parallel.h"
+#include "emoface/common/timing.h"
 #include "emoface/expression/default_face.h"
 #include "emoface/expression/face_io.h"
 #include "emoface/fap/fap_io.h"
@@ -24,11 +24,6 @@
 namespace emoface::apps {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 bool ends_with(const std::string& s, const std::string& suffix) {
     if (s.size() < suffix.size()) return false;
@@ -81,7 +76,9 @@ std::string format_times(const LoadTimes& load, const FrameTimeTotals& frames) {
                            m.total_ms > 0 ? 1000.0 / m.total_ms : 0.0);
         out += fmt::format(
             "    rig {:.2f} | layout {:.2f} | morph {:.2f} | wrinkle UVs {:.2f} | tangents {:.2f} | "
-            "upload {:.2f} | draw {:.2f} | read back {:.2f}\n",
+            "upload {:.2f} | draw {:.2f} | read back {:.2f}\n"
+            "    (wall clock; draw runs to a glFinish, so it holds the rasterisation (llvmpipe: on the "
+            "CPU) and any GPU morph still running; read back: resolve + read RGBA)\n",
             m.scene.rig_ms, m.scene.layout_ms, m.scene.morph_ms, m.scene.uv_ms, m.scene.tangents_ms,
             m.scene.upload_ms, m.draw_ms, m.readback_ms);
     }
@@ -127,10 +124,22 @@ morph::Backend parse_backend(const std::string& text, const std::string& command
 
 void check_output_folder(const std::string& path, const std::string& command,
                          const std::string& option) {
+    namespace fs = std::filesystem;
     if (path.empty()) fail<InputError>("{}: {} is empty", command, option);
-    const auto dir = std::filesystem::path(path).parent_path();
-    if (!dir.empty() && !std::filesystem::is_directory(dir))
-        fail<InputError>("{}: {} {}: folder {} does not exist", command, option, path, dir.string());
+    const fs::path dir = fs::path(path).parent_path();
+    if (dir.empty()) return;
+    std::error_code ec;
+    if (fs::is_directory(dir, ec)) return;
+    // A missing folder is made (as `wrinkles --out` makes its own), so
+    // `--out out/demo.mp4` works in a fresh checkout; a file in the way is
+    // named rather than left to create_directories' generic message.
+    for (fs::path up = dir; !up.empty(); up = up.parent_path()) {
+        if (fs::exists(up, ec) && !fs::is_directory(up, ec))
+            fail<InputError>("{}: {} {}: {} is a file, not a folder", command, option, path, up.string());
+        if (up == up.parent_path()) break;
+    }
+    fs::create_directories(dir, ec);
+    if (ec) fail<InputError>("{}: {} {}: cannot make folder {}: {}", command, option, path, dir.string(), ec.message());
 }
 
 SessionOptions SessionArgs::resolve(const std::string& command, int width, int height) const {
@@ -139,11 +148,15 @@ SessionOptions SessionArgs::resolve(const std::string& command, int width, int h
     const auto kind = render::parse_wrinkle_layout(layout);
     if (!kind) fail<InputError>("{}: --layout '{}': expected projective or anchored", command, layout);
     o.layout = *kind;
+    if (shading == "skin") o.shading = render::Shading::Skin;
+    else if (shading == "thesis") o.shading = render::Shading::Thesis;
+    else fail<InputError>("{}: --shading '{}': expected skin or thesis", command, shading);
     o.wrinkles = !no_wrinkles;
     o.width = width;
     o.height = height;
-    if (o.wrinkle_size < 256 || o.wrinkle_size > 4096)
-        fail<InputError>("{}: --wrinkle-size {}: expected 256..4096", command, o.wrinkle_size);
+    render::check_wrinkle_map_size(o.wrinkle_size, command + ": --wrinkle-size");
+    if (o.side_by_side && !o.wrinkles)
+        fail<InputError>("{}: --side-by-side draws with and without wrinkles: leave out --no-wrinkles", command);
     if (!(o.face_resolution >= 0.1 && o.face_resolution <= 2.0))
         fail<InputError>("{}: --face-resolution {}: expected 0.1..2", command, o.face_resolution);
     if (o.texture_size != 0 && (o.texture_size < 64 || o.texture_size > 8192))
@@ -160,6 +173,10 @@ void add_session_options(CLI::App& sub, SessionArgs& a) {
     sub.add_option("--wrinkle-size", o.wrinkle_size, "Side of the wrinkle maps (256..4096)")->capture_default_str();
     sub.add_option("--samples", o.samples, "Multisampling samples")->check(CLI::Range(1, 16))->capture_default_str();
     sub.add_flag("--no-wrinkles", a.no_wrinkles, "Draw without the wrinkle maps");
+    sub.add_option("--shading", a.shading,
+                   "skin (scattering, two-lobe sheen, pores, light rig of data/render/skin.json) or "
+                   "thesis (the thesis's Blinn-Phong)")
+        ->capture_default_str();
     sub.add_option("--wrinkles", o.wrinkle_folder,
                    "Folder of key wrinkle maps + layouts (as `emoface wrinkles` writes; maps may be painted)");
     sub.add_option("--face-resolution", o.face_resolution,
@@ -172,6 +189,21 @@ void add_session_options(CLI::App& sub, SessionArgs& a) {
                    "Texture space of the wrinkle maps: projective (frontal projection, the default face) "
                    "or anchored (the mesh's own UVs, for maps painted in UV space)")
         ->capture_default_str();
+}
+
+CLI::Option* add_side_by_side_option(CLI::App& sub, SessionArgs& a) {
+    return sub.add_flag("--side-by-side", a.options.side_by_side,
+                        "Two pictures of each pose side by side: with the wrinkle maps (left) and without "
+                        "(right); the output is twice as wide as --size");
+}
+
+void require_display(const std::string& command, const std::string& what, const std::string& headless) {
+    const char* display = std::getenv("DISPLAY");
+    const char* wayland = std::getenv("WAYLAND_DISPLAY");
+    if ((display && *display) || (wayland && *wayland)) return;
+    fail<EnvironmentError>("{}: no display for {} (DISPLAY is not set): {}, or run it in a desktop session, "
+                           "over `ssh -X`, or under a virtual X server (`xvfb-run -a emoface {} ...`)",
+                           command, what, headless, command);
 }
 
 expression::Face load_session_face(const SessionOptions& o) {
@@ -217,63 +249,35 @@ expression::Face load_session_face(const SessionOptions& o) {
 // --- Session -----------------------------------------------------------------
 
 Session::Session(const SessionOptions& options, render::Platform* window) : options_(options) {
-    if (options_.wrinkle_size < 256 || options_.wrinkle_size > 4096)
-        fail<InputError>("session: wrinkle map size {}: expected 256..4096", options_.wrinkle_size);
     if (options_.backend == morph::Backend::Cuda && !morph::cuda_available())
         fail<EnvironmentError>("session: --backend cuda: {} (use --backend cpu or auto)",
                                morph::cuda_device_description());
-    for (const char* file : {"emotions.json", "visemes.json", "feature_lines.json", "wrinkles.json"})
-        if (!std::filesystem::is_regular_file(options_.data + "/expression/" + file))
-            fail<InputError>("session: data folder {}: expression/{} is missing (point --data at the "
-                             "project's data/)",
-                             options_.data, file);
 
     auto t = Clock::now();
-    assets_ = std::make_unique<render::FaceAssets>();
-    render::FaceAssets& a = *assets_;
-    a.layout = options_.layout;
-    a.face = load_session_face(options_);
+    expression::Face face = load_session_face(options_);
     load_.face_ms = ms_since(t);
 
-    t = Clock::now();
-    a.rig = std::make_unique<expression::FaceRig>(a.face);
-    load_.rig_ms = ms_since(t);
-
-    t = Clock::now();
-    const std::string dir = options_.data + "/expression/";
-    a.emotions = expression::load_emotion_profiles(dir + "emotions.json");
-    a.visemes = expression::load_viseme_profiles(dir + "visemes.json");
-    std::bitset<expression::kFeatureCount> present;
-    for (int i = 0; i < expression::kFeatureCount; ++i) present[i] = a.face.feature_points[i].present;
-    a.lines = expression::lines_for_face(expression::load_feature_lines(dir + "feature_lines.json"), present);
-    const expression::WrinkleLibrarySpec spec = expression::load_wrinkle_spec(dir + "wrinkles.json");
-    load_.profiles_ms = ms_since(t);
-
-    // The seven keys, each at its own expression's full intensity (neutral:
-    // no FAPs); independent, so generated side by side.
-    t = Clock::now();
-    if (!options_.wrinkle_folder.empty()) {
-        a.keys = render::read_wrinkle_keys(options_.wrinkle_folder, a.lines);
-        options_.wrinkle_size = a.keys.front().map.width;
-    }
-    a.keys.resize(expression::kWrinkleKeyCount);
-    if (options_.wrinkle_folder.empty())
-        parallel_for(expression::kWrinkleKeyCount, 1, [&](int begin, int end) {
-            for (int k = begin; k < end; ++k) {
-                expression::FapValues pose{};
-                if (k > 0) pose = a.emotions.profiles[std::size_t(k - 1)];
-                a.keys[std::size_t(k)] = render::make_wrinkle_key(a.face, *a.rig, spec, expression::WrinkleKey(k),
-                                                                  pose, options_.wrinkle_size, options_.layout);
-            }
-        });
-    load_.keys_ms = ms_since(t);
+    render::FaceAssetsOptions ao;
+    ao.wrinkle_map_size = options_.wrinkle_size;
+    ao.layout = options_.layout;
+    if (!options_.wrinkle_folder.empty())
+        ao.read_keys = [folder = options_.wrinkle_folder](const std::vector<expression::FeatureLine>& lines) {
+            return render::read_wrinkle_keys(folder, lines);
+        };
+    assets_ = render::load_face_assets(std::move(face), options_.data, ao);
+    skin_ = render::load_skin_shading(options_.data + "/render/skin.json");
+    // Read maps have their own size.
+    options_.wrinkle_size = assets_->keys.front().map.width;
+    load_.rig_ms = assets_->times.rig_ms;
+    load_.profiles_ms = assets_->times.profiles_ms;
+    load_.keys_ms = assets_->times.keys_ms;
 
     t = Clock::now();
     if (window) {
         platform_ = window;
     } else {
         render::PlatformOptions po;
-        po.width = options_.width;
+        po.width = options_.picture_width();
         po.height = options_.height;
         po.samples = options_.samples;
         // With CUDA, the EGL device that is the morph's GPU (interop).
@@ -346,6 +350,8 @@ render::DrawOptions Session::draw_options(float aspect) const {
     d.camera = scene_->frontal_camera(aspect);
     d.light = scene_->portrait_light();
     d.wrinkles = options_.wrinkles;
+    d.shading = options_.shading;
+    d.skin = skin_;
     return d;
 }
 
@@ -353,7 +359,28 @@ render::ImageRGBA8 Session::render_frame(const expression::FaceState& state) {
     const auto t0 = Clock::now();
     update(state);
     platform_->begin_frame();
-    draw(draw_options(float(platform_->width()) / float(platform_->height())));
+    render::DrawOptions d = draw_options(float(options_.width) / float(options_.height));
+    if (options_.side_by_side) {
+        // One pose, one camera: the halves differ only where the wrinkle
+        // maps change the shading.
+        d.viewport = {0, 0, options_.width, options_.height};
+        d.wrinkles = true;
+        draw(d);
+        const double with_ms = last_.draw_ms;
+        d.viewport = {options_.width, 0, options_.width, options_.height};
+        d.wrinkles = false;
+        draw(d);
+        last_.draw_ms += with_ms;
+    } else {
+        draw(d);
+    }
+    // The draw's GPU work counts as draw, not as read back (which would
+    // otherwise wait for it): on llvmpipe that is the rasterisation, on a GPU
+    // also a CUDA morph still running. The read back follows at once, so
+    // waiting here loses no overlap.
+    const auto f = Clock::now();
+    scene_->finish();
+    last_.draw_ms += ms_since(f);
     const auto t = Clock::now();
     platform_->end_frame();
     render::ImageRGBA8 image = platform_->read_rgba();
@@ -373,9 +400,9 @@ render::ImageRGBA8 Session::wrinkle_map() const {
     return out;
 }
 
-std::array<std::optional<glm::vec2>, 84> Session::screen_points(const render::Camera& camera, int width,
+std::array<std::optional<glm::vec2>, expression::kFeatureCount> Session::screen_points(const render::Camera& camera, int width,
                                                                 int height) const {
-    std::array<std::optional<glm::vec2>, 84> out{};
+    std::array<std::optional<glm::vec2>, expression::kFeatureCount> out{};
     const glm::mat4 m = camera.projection * camera.view;
     for (std::size_t i = 0; i < out.size(); ++i) {
         if (!points_[i]) continue;

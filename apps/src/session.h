@@ -1,8 +1,9 @@
 #pragma once
 // What every drawing command (play, mix, inspect, morph) and the viewer share:
-// a face with its rig, profiles, feature lines and seven key wrinkle maps
-// (generated once and kept in memory), a GL platform (headless, or a window
-// the caller made) and the FaceScene that draws one frame of it.
+// a face and its assets (render::load_face_assets: rig, profiles, feature
+// lines, and the seven key wrinkle maps, generated once or read from a
+// --wrinkles folder), a GL platform (headless, or a window the caller made)
+// and the FaceScene that draws one frame of it.
 //
 //   Session s(options);                       // headless, options.width x height
 //   auto state = s.face_state(stream.resolved(k));
@@ -31,7 +32,8 @@
 
 namespace CLI {
 class App;
-}
+class Option;
+}  // namespace CLI
 
 namespace emoface::apps {
 
@@ -45,13 +47,25 @@ struct SessionOptions {
     morph::Backend backend = morph::Backend::Auto;
     int wrinkle_size = 512;  // side of the key and morphed wrinkle maps, 256..4096
     bool wrinkles = true;    // false: draw with geometric normals only
+    // Skin (data/render/skin.json's model and light rig) or the thesis's
+    // Blinn-Phong (5.5.1) under the portrait light alone.
+    render::Shading shading = render::Shading::Skin;
     // The wrinkle maps' texture space: projective (the default face), or
     // anchored (the mesh's own UVs; maps painted in UV space).
     render::WrinkleLayout layout = render::WrinkleLayout::Projective;
-    // Headless platform only (a window has its own size).
+    // The picture's size (headless), or the viewer window's.
     int width = 640;
     int height = 480;
     int samples = 4;
+    // Headless pictures: two of width x height side by side, with the
+    // wrinkle maps (left) and without (right), one pose.
+    bool side_by_side = false;
+    // The width of a rendered picture: width, or twice it side by side.
+    int picture_width() const { return side_by_side ? 2 * width : width; }
+    // For reports: "" (with wrinkles), ", without wrinkles" or ", with | without wrinkles".
+    const char* wrinkles_note() const {
+        return side_by_side ? ", with | without wrinkles" : wrinkles ? "" : ", without wrinkles";
+    }
     // The default face's mesh resolution (1 = face.json's) and base-colour
     // size (0 = face.json's): smaller loads faster (tests, quick looks).
     // A folder of key wrinkle maps with their layouts (as `emoface wrinkles`
@@ -61,19 +75,25 @@ struct SessionOptions {
     int texture_size = 0;
 };
 
-// The options every drawing command shares, as they come from the command
-// line: --face, --fdp, --backend, --wrinkle-size, --samples, --no-wrinkles,
-// --face-resolution, --texture-size, --data, --layout.
+// The options every drawing command (play, mix, inspect, morph) and `view`
+// share, as they come from the command line: --face, --fdp, --backend,
+// --wrinkle-size, --samples, --no-wrinkles, --wrinkles, --face-resolution,
+// --texture-size, --data, --layout; the commands that write pictures (play,
+// mix) add --side-by-side.
 struct SessionArgs {
     SessionOptions options;
     std::string backend = "auto";
     std::string layout = "projective";
+    std::string shading = "skin";
     bool no_wrinkles = false;
     // Checks and resolves them (InputError starting `command: `); width and
     // height are the headless platform's.
     SessionOptions resolve(const std::string& command, int width, int height) const;
 };
 void add_session_options(CLI::App& command, SessionArgs& args);
+// --side-by-side (with | without wrinkles), for the commands that write
+// pictures; returned so a command can tie it to its --out.
+CLI::Option* add_side_by_side_option(CLI::App& command, SessionArgs& args);
 
 // Wall-clock milliseconds of loading, once per session.
 struct LoadTimes {
@@ -91,8 +111,9 @@ struct LoadTimes {
 // Wall-clock milliseconds of one frame's stages.
 struct FrameTimes {
     render::FrameStageTimes scene;  // rig, layout, morph, uv, tangents, upload
-    double draw_ms = 0;             // the GL draw (submission)
-    double readback_ms = 0;         // resolve + read RGBA (waits for the GPU)
+    double draw_ms = 0;             // the GL draw: in render_frame() up to a glFinish (the GPU's
+                                    // work included), in draw() its submission only
+    double readback_ms = 0;         // resolve + read RGBA
     double total_ms = 0;            // the whole render_frame()
 };
 
@@ -119,8 +140,14 @@ std::pair<int, int> parse_size(const std::string& text, const std::string& comma
                                const std::string& option = "--size");
 // "auto" | "cpu" | "cuda"; InputError otherwise.
 morph::Backend parse_backend(const std::string& text, const std::string& command);
-// Throws InputError when `path`'s folder does not exist (checked before the
-// slow part, so bad input fails fast and writes nothing).
+// Throws EnvironmentError "COMMAND: no display for WHAT (DISPLAY is not
+// set): HEADLESS, or run it ..." when no window can be opened (neither
+// DISPLAY nor WAYLAND_DISPLAY set); `headless` names the way without one.
+void require_display(const std::string& command, const std::string& what, const std::string& headless);
+// Makes `path`'s folder (and its parents) when it is missing; InputError
+// when it cannot be made (a file in the way, no permission). Call it after
+// the other checks and before the slow part, so bad input fails fast and
+// leaves nothing behind.
 void check_output_folder(const std::string& path, const std::string& command,
                          const std::string& option = "--out");
 
@@ -148,17 +175,19 @@ public:
     // The frontal camera and portrait light for this aspect ratio, wrinkles
     // as the options say.
     render::DrawOptions draw_options(float aspect) const;
-    // update + begin_frame + draw (frontal, whole target) + end_frame + read.
+    // update + begin_frame + draw (frontal, whole target; with
+    // options.side_by_side: with wrinkles left, without right) + end_frame +
+    // read.
     render::ImageRGBA8 render_frame(const expression::FaceState& state);
 
     // The current (morphed) wrinkle map, RGBA8 normal map, rows top first.
     render::ImageRGBA8 wrinkle_map() const;
     // The current pose's feature points in face space (absent: nullopt).
-    const std::array<std::optional<glm::vec3>, 84>& feature_points() const { return points_; }
+    const std::array<std::optional<glm::vec3>, expression::kFeatureCount>& feature_points() const { return points_; }
     // The feature points projected by `camera` to pixel coordinates of a
     // width x height image (x right, y DOWN from the top row); nullopt for
     // absent points and those behind the camera.
-    std::array<std::optional<glm::vec2>, 84> screen_points(const render::Camera& camera, int width,
+    std::array<std::optional<glm::vec2>, expression::kFeatureCount> screen_points(const render::Camera& camera, int width,
                                                            int height) const;
     // The current layout L*: feature points in wrinkle-map coordinates
     // (normalised, y down).
@@ -170,6 +199,10 @@ public:
     void set_backend(morph::Backend backend);
     morph::Backend backend() const { return scene_->morpher().backend(); }
     void set_wrinkles(bool on) { options_.wrinkles = on; }
+    void set_shading(render::Shading shading) { options_.shading = shading; }
+    render::Shading shading() const { return options_.shading; }
+    // The skin model's parameters and light rig (data/render/skin.json).
+    const render::SkinShading& skin() const { return skin_; }
     bool wrinkles() const { return options_.wrinkles; }
 
     const SessionOptions& options() const { return options_; }
@@ -188,10 +221,11 @@ private:
 
     SessionOptions options_;
     std::unique_ptr<render::FaceAssets> assets_;
+    render::SkinShading skin_;  // data/render/skin.json
     std::unique_ptr<render::Platform> owned_platform_;
     render::Platform* platform_ = nullptr;
     std::unique_ptr<render::FaceScene> scene_;
-    std::array<std::optional<glm::vec3>, 84> points_{};
+    std::array<std::optional<glm::vec3>, expression::kFeatureCount> points_{};
     LoadTimes load_;
     FrameTimes last_;
     FrameTimeTotals totals_;

@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
@@ -50,30 +51,30 @@ double seconds_since(Clock::time_point t) {
     return std::chrono::duration<double>(Clock::now() - t).count();
 }
 
-constexpr const char* kNoDisplayFix =
-    "run it in a desktop session, over `ssh -X`, or under a virtual X server "
-    "(`xvfb-run -a emoface view ...`); to render without a window use "
-    "`emoface play FILE.fap --out out.mp4`";
+// How to get the picture without a window, per command that opens the viewer.
+std::string headless_way(const std::string& command) {
+    if (command == "mix") return "give --out face.png to write the picture instead";
+    if (command == "play") return "give --out out.mp4 to render headless instead";
+    return "to render without a window use `emoface play FILE.fap --out out.mp4`";
+}
 
 // Opens the window, turning GLFW's failure into a message that names the fix.
 std::unique_ptr<render::WindowPlatform> open_window(const ViewerOptions& o) {
-    const char* display = std::getenv("DISPLAY");
-    if (!display || !*display)
-        fail<EnvironmentError>("view: no display to open a window on (DISPLAY is not set): {}",
-                               kNoDisplayFix);
+    require_display(o.command, "the viewer", headless_way(o.command));
     render::PlatformOptions po;
-    po.width = o.width;
-    po.height = o.height;
-    po.samples = 4;
+    po.width = o.session.width;
+    po.height = o.session.height;
+    po.samples = o.session.samples;
     po.title = "emoface view (loading)";
     po.vsync = true;
     try {
         return std::make_unique<render::WindowPlatform>(po);
     } catch (const EnvironmentError& e) {
+        const char* display = std::getenv("DISPLAY");
         fail<EnvironmentError>(
-            "view: cannot open a window on DISPLAY={} ({}): check that the X server runs and "
+            "{}: cannot open a window on DISPLAY={} ({}): check that the X server runs and "
             "lets you connect (xauth), or {}",
-            display, e.what(), kNoDisplayFix);
+            o.command, display ? display : "", e.what(), headless_way(o.command));
     }
 }
 
@@ -142,6 +143,23 @@ ImU32 region_colour(const std::string& region) {
     return palette[h % palette.size()];
 }
 
+// The panel's width; its text wraps at it.
+constexpr float kPanelWidth = 380.0f;
+
+// Greyed text (help, status), wrapped at the panel's edge instead of cut off.
+void disabled_wrapped(const std::string& text) {
+    ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyle().Colors[ImGuiCol_TextDisabled]);
+    ImGui::TextWrapped("%s", text.c_str());
+    ImGui::PopStyleColor();
+}
+
+// An error in red, wrapped.
+void error_wrapped(const std::string& text) {
+    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.4f, 0.4f, 1));
+    ImGui::TextWrapped("%s", text.c_str());
+    ImGui::PopStyleColor();
+}
+
 class Viewer {
 public:
     Viewer(const ViewerOptions& options, render::WindowPlatform& window, ImGuiLayer& gui,
@@ -151,14 +169,14 @@ public:
             sliders_[std::size_t(expression::emotion_index(e))] = float(mix[e]);
         driven_by_file_ = stream_.has_value() && options.mix.empty();
         playing_ = driven_by_file_;
-        wrinkles_ = options.wrinkles;
+        wrinkles_ = options.session.wrinkles;
+        thesis_shading_ = options.session.shading == render::Shading::Thesis;
         show_points_ = options.show_points || options.show_labels;
         show_lines_ = options.show_lines;
         show_labels_ = options.show_labels;
-        backend_choice_ = int(options.backend);
+        backend_choice_ = int(options.session.backend);
         cuda_ok_ = morph::cuda_available();
         reset_view();
-        std::snprintf(mix_text_, sizeof mix_text_, "%s", mix.to_string().c_str());
     }
 
     // Runs until the window closes or quit_after_frames frames were shown.
@@ -295,6 +313,8 @@ private:
         d.light = session_.scene().portrait_light();
         d.light.position = light_.direction();
         d.wrinkles = wrinkles_;
+        d.shading = thesis_shading_ ? render::Shading::Thesis : render::Shading::Skin;
+        d.skin = session_.skin();
         window_.begin_frame();
         const auto t = Clock::now();
         session_.draw(d);
@@ -315,7 +335,7 @@ private:
         const auto& face = session_.assets().face;
         const auto& mesh = session_.scene().mesh();
         const glm::vec3 eye = camera_.eye();
-        std::array<bool, 84> visible{};
+        std::array<bool, expression::kFeatureCount> visible{};
         for (std::size_t i = 0; i < screen.size(); ++i) {
             if (!screen[i]) continue;
             const int v = face.feature_points[i].vertex;
@@ -350,22 +370,28 @@ private:
     }
 
     void draw_panel() {
+        // The panel fits its content, at a fixed width (long lines wrap), and
+        // at most the window's height: below that it scrolls instead of
+        // running off the window's bottom edge.
+        const float height = ImGui::GetIO().DisplaySize.y;
         ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
-        ImGui::SetNextWindowSize(ImVec2(360, 0), ImGuiCond_FirstUseEver);
+        ImGui::SetNextWindowSizeConstraints(ImVec2(kPanelWidth, 0), ImVec2(kPanelWidth, std::max(64.0f, height - 16)));
         // A small window starts with the panel folded, so the face shows.
         ImGui::SetNextWindowCollapsed(window_.width() < 800, ImGuiCond_FirstUseEver);
         ImGui::SetNextWindowBgAlpha(0.82f);
-        ImGui::Begin("emoface");
+        ImGui::Begin("emoface", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
         frame_time_section();
         if (stream_) timeline_section();
         emotion_section();
         display_section();
         backend_section();
+        ImGui::SetNextItemOpen(options_.show_wrinkle_map, ImGuiCond_Once);
         if (ImGui::CollapsingHeader("Wrinkle map")) wrinkle_map_section();
         ImGui::Separator();
-        ImGui::TextDisabled("left-drag orbit, wheel zoom, middle-drag pan,\n"
-                            "right-drag light, R reset view, space play/pause,\n"
-                            "Esc quit");
+        disabled_wrapped(stream_ ? "left-drag orbit, wheel zoom, middle-drag pan, right-drag light, R reset view, "
+                                   "space play/pause, Esc quit"
+                                 : "left-drag orbit, wheel zoom, middle-drag pan, right-drag light, R reset view, "
+                                   "Esc quit");
         ImGui::End();
     }
 
@@ -374,8 +400,8 @@ private:
         ImGui::Text("frame %.1f ms (%.0f frames/s at most)", ms, ms > 0 ? 1000.0 / ms : 0.0);
         const auto& s = session_.scene().last_times();
         ImGui::Text("update %.1f ms, draw %.1f ms (submission)", update_ms_, draw_ms_);
-        ImGui::TextDisabled("rig %.1f  layout %.1f  morph %.1f  uv %.1f\ntangents %.1f  upload %.1f",
-                            s.rig_ms, s.layout_ms, s.morph_ms, s.uv_ms, s.tangents_ms, s.upload_ms);
+        disabled_wrapped(fmt::format("rig {:.1f}  layout {:.1f}  morph {:.1f}  uv {:.1f}  tangents {:.1f}  upload {:.1f}",
+                                     s.rig_ms, s.layout_ms, s.morph_ms, s.uv_ms, s.tangents_ms, s.upload_ms));
         ImGui::PlotLines("##frame ms", history_.data(), int(history_.size()),
                          int(history_at_ % history_.size()), "frame ms", 0.0f, FLT_MAX,
                          ImVec2(-1, 32));
@@ -405,7 +431,7 @@ private:
             driven_by_file_ = true;
             dirty_ = true;
         }
-        ImGui::Text("%.2f s / %.2f s, mix %s", time_, double(last) / fps,
+        ImGui::TextWrapped("%.2f s / %.2f s, mix %s", time_, double(last) / fps,
                     expression::mix_source_name(state_.mix_source));
         if (!driven_by_file_) {
             ImGui::TextColored(ImVec4(1, 0.8f, 0.4f, 1), "the sliders drive the face");
@@ -438,8 +464,14 @@ private:
         ImGui::ProgressBar(std::min(sum, 1.0f), ImVec2(-1, 0), overlay);
         if (scaled_others_ && sum >= 0.999f)
             ImGui::TextColored(ImVec4(1, 0.8f, 0.4f, 1), "sum at 1: the other sliders were scaled down");
+        // The box shows the mix the sliders show (a file's fitted mix
+        // included), except while it is being typed in.
+        if (!mix_box_active_) std::snprintf(mix_text_, sizeof mix_text_, "%s", mix_label(slider_mix()).c_str());
         ImGui::SetNextItemWidth(200);
-        if (ImGui::InputText("mix", mix_text_, sizeof mix_text_, ImGuiInputTextFlags_EnterReturnsTrue)) {
+        const bool entered =
+            ImGui::InputText("mix", mix_text_, sizeof mix_text_, ImGuiInputTextFlags_EnterReturnsTrue);
+        mix_box_active_ = ImGui::IsItemActive();
+        if (entered) {
             try {
                 const expression::EmotionMix m = expression::parse_emotion_mix(mix_text_, true);
                 for (std::size_t i = 0; i < sliders_.size(); ++i) sliders_[i] = float(m.weights[i]);
@@ -458,26 +490,31 @@ private:
             playing_ = false;
             dirty_ = true;
         }
-        if (!mix_error_.empty()) ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "%s", mix_error_.c_str());
+        if (!mix_error_.empty()) error_wrapped(mix_error_);
     }
 
     void display_section() {
         if (!ImGui::CollapsingHeader("Display", ImGuiTreeNodeFlags_DefaultOpen)) return;
         ImGui::Checkbox("wrinkles", &wrinkles_);
         ImGui::SameLine();
+        ImGui::Checkbox("thesis shading", &thesis_shading_);
         ImGui::Checkbox("feature points", &show_points_);
         ImGui::Checkbox("feature lines", &show_lines_);
         ImGui::SameLine();
         ImGui::BeginDisabled(!show_points_);
         ImGui::Checkbox("labels", &show_labels_);
         ImGui::EndDisabled();
+        // The light's angles are read beside their sliders: ImGui writes a
+        // slider's value in its middle, where the handle covers it at 0 deg.
         float az = light_.azimuth * 57.29578f, el = light_.elevation * 57.29578f;
         ImGui::SetNextItemWidth(200);
-        if (ImGui::SliderFloat("light azimuth", &az, -180.0f, 180.0f, "%.0f deg"))
-            light_.azimuth = az / 57.29578f;
+        if (ImGui::SliderFloat("##light azimuth", &az, -180.0f, 180.0f, "")) light_.azimuth = az / 57.29578f;
+        ImGui::SameLine();
+        ImGui::Text("light azimuth %+.0f deg", double(az));
         ImGui::SetNextItemWidth(200);
-        if (ImGui::SliderFloat("light elevation", &el, -85.0f, 85.0f, "%.0f deg"))
-            light_.elevation = el / 57.29578f;
+        if (ImGui::SliderFloat("##light elevation", &el, -85.0f, 85.0f, "")) light_.elevation = el / 57.29578f;
+        ImGui::SameLine();
+        ImGui::Text("elevation %+.0f deg", double(el));
         if (ImGui::Button("reset view")) reset_view();
     }
 
@@ -502,9 +539,8 @@ private:
         }
         ImGui::Text("morph on %s%s", morph::to_string(session_.backend()),
                     session_.scene().uses_interop() ? " (CUDA-GL interop)" : "");
-        if (!cuda_ok_) ImGui::TextDisabled("CUDA: %s", morph::cuda_device_description().c_str());
-        if (!backend_error_.empty())
-            ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "%s", backend_error_.c_str());
+        if (!cuda_ok_) disabled_wrapped("CUDA: " + morph::cuda_device_description());
+        if (!backend_error_.empty()) error_wrapped(backend_error_);
     }
 
     void wrinkle_map_section() {
@@ -537,10 +573,12 @@ private:
     std::array<float, 6> sliders_{};
     bool scaled_others_ = false;
     char mix_text_[128] = {};
+    bool mix_box_active_ = false;
     std::string mix_error_, backend_error_;
 
     OrbitCamera camera_;
     LightControl light_;
+    bool thesis_shading_ = false;  // the thesis's Blinn-Phong instead of the skin model
     bool wrinkles_ = true, show_points_ = false, show_lines_ = false, show_labels_ = false;
     int backend_choice_ = 0;
     bool cuda_ok_ = false;
@@ -557,41 +595,58 @@ private:
 
 }  // namespace
 
+void add_viewer_options(CLI::App& sub, ViewerOptions& o, CLI::Option* out) {
+    const std::string which = out ? "Viewer (without --out): " : "";
+    CLI::Option* const added[] = {
+        sub.add_flag("--points", o.show_points, which + "start with the feature points shown"),
+        sub.add_flag("--lines", o.show_lines, which + "start with the morph's feature lines shown"),
+        sub.add_flag("--labels", o.show_labels,
+                     which + "start with the feature points shown with their labels (2.1 ... 11.6)"),
+        sub.add_flag("--wrinkle-map", o.show_wrinkle_map,
+                     which + "start with the morphed wrinkle map (and L*) shown in the panel"),
+        sub.add_option("--quit-after", o.quit_after_frames,
+                       which + "close after this many frames (0: when the window is closed)")
+            ->check(CLI::NonNegativeNumber),
+        sub.add_option("--screenshot", o.screenshot,
+                       which + "write the window's last frame to this image (.png, ...) on closing"),
+    };
+    // Given with --out they would be ignored: say so instead.
+    if (out)
+        for (CLI::Option* option : added) option->excludes(out);
+}
+
 int run_viewer(const ViewerOptions& options) {
+    const std::string& command = options.command;
     // Bad input fails before anything opens.
-    if (options.width < 64 || options.height < 64 || options.width > 8192 || options.height > 8192)
-        fail<InputError>("view: window size {}x{}: expected 64..8192 on each side", options.width,
-                         options.height);
-    if (options.wrinkle_size < 256 || options.wrinkle_size > 4096)
-        fail<InputError>("view: --wrinkle-size {}: expected 256..4096", options.wrinkle_size);
+    const SessionOptions& so = options.session;
+    if (so.width < 64 || so.height < 64 || so.width > 8192 || so.height > 8192)
+        fail<InputError>("{}: window size {}x{}: expected 64..8192 on each side", command, so.width, so.height);
+    if (so.side_by_side)
+        fail<InputError>("{}: --side-by-side is for pictures written with --out, not the viewer", command);
     if (options.quit_after_frames < 0)
-        fail<InputError>("view: --quit-after {}: expected a frame count >= 0", options.quit_after_frames);
+        fail<InputError>("{}: --quit-after {}: expected a frame count >= 0", command, options.quit_after_frames);
     std::optional<fap::FapStream> stream;
     if (!options.fap_path.empty()) stream = fap::resolve_untransmitted(load_fap_stream(options.fap_path));
     const expression::EmotionMix mix =
         options.mix.empty() ? expression::EmotionMix{} : expression::parse_emotion_mix(options.mix);
-    if (options.face != "default" && !std::filesystem::is_regular_file(options.face))
-        fail<InputError>("view: --face {}: no such file (expected default, FILE.wfm or FILE.obj)",
-                         options.face);
-    if (!options.fdp.empty() && !std::filesystem::is_regular_file(options.fdp))
-        fail<InputError>("view: --fdp {}: no such file", options.fdp);
-    if (!options.screenshot.empty()) check_output_folder(options.screenshot, "view", "--screenshot");
-    if (options.backend == morph::Backend::Cuda && !morph::cuda_available())
-        fail<EnvironmentError>("view: --backend cuda: {} (use --backend cpu or auto)",
+    if (so.face != "default" && !std::filesystem::is_regular_file(so.face))
+        fail<InputError>("{}: --face {}: no such file (expected default, FILE.wfm or FILE.obj)", command, so.face);
+    if (!so.fdp.empty() && !std::filesystem::is_regular_file(so.fdp))
+        fail<InputError>("{}: --fdp {}: no such file", command, so.fdp);
+    if (!so.wrinkle_folder.empty() && !std::filesystem::is_directory(so.wrinkle_folder))
+        fail<InputError>("{}: --wrinkles {}: no such folder (expected one `emoface wrinkles --out` wrote)", command,
+                         so.wrinkle_folder);
+    if (!options.screenshot.empty()) check_output_folder(options.screenshot, command, "--screenshot");
+    if (so.backend == morph::Backend::Cuda && !morph::cuda_available())
+        fail<EnvironmentError>("{}: --backend cuda: {} (use --backend cpu or auto)", command,
                                morph::cuda_device_description());
 
     auto window = open_window(options);
     auto gui = std::make_unique<ImGuiLayer>(window->window());
     draw_loading_frame(*window, *gui, "loading the face and its wrinkle maps ...");
 
-    SessionOptions so;
-    so.face = options.face;
-    so.fdp = options.fdp;
-    so.backend = options.backend;
-    so.wrinkles = options.wrinkles;
-    so.wrinkle_size = options.wrinkle_size;
     Session session(so, window.get());
-    spdlog::debug("view: {} on {}", session.description(), window->description());
+    spdlog::debug("{}: {} on {}", command, session.description(), window->description());
 
     {
         Viewer viewer(options, *window, *gui, session, std::move(stream), mix);
@@ -600,7 +655,7 @@ int run_viewer(const ViewerOptions& options) {
     if (!options.screenshot.empty()) {
         window->make_current();
         render::write_image(options.screenshot, window->read_rgba());
-        std::printf("view: wrote %s (%dx%d, the window's last frame)\n", options.screenshot.c_str(),
+        std::printf("%s: wrote %s (%dx%d, the window's last frame)\n", command.c_str(), options.screenshot.c_str(),
                     window->width(), window->height());
     }
     gui.reset();  // before the session and window it draws into

@@ -1,21 +1,44 @@
 #include "emoface/render/face_assets.h"
 
 #include <algorithm>
+#include <bitset>
+#include <chrono>
+#include <filesystem>
 
 #include "emoface/common/error.h"
+#include "emoface/common/parallel.h"
+#include "emoface/common/timing.h"
 
 namespace emoface::render {
 
+namespace {
+
+}  // namespace
+
+void check_wrinkle_map_size(int size, const std::string& what) {
+    if (size < kMinWrinkleMapSize || size > kMaxWrinkleMapSize)
+        fail<InputError>("{} {}: expected {}..{}", what, size, kMinWrinkleMapSize, kMaxWrinkleMapSize);
+}
+
 std::unique_ptr<FaceAssets> load_face_assets(expression::Face face, const std::string& data_dir,
                                              const FaceAssetsOptions& options) {
-    if (options.wrinkle_map_size < 256 || options.wrinkle_map_size > 4096)
-        fail<InputError>("render: wrinkle map size must be in 256..4096, got {}",
-                         options.wrinkle_map_size);
+    if (!options.read_keys) check_wrinkle_map_size(options.wrinkle_map_size, "render: wrinkle map size");
+    const std::string dir = data_dir + "/expression/";
+    // Every data file is looked for first, so a wrong folder fails before the
+    // slow part with the fix, not with the first reader's "cannot open".
+    for (const char* file : {"emotions.json", "visemes.json", "feature_lines.json", "wrinkles.json"})
+        if (!std::filesystem::is_regular_file(dir + file))
+            fail<InputError>("render: data folder {}: expression/{} is missing (expected the project's data/)",
+                             data_dir, file);
     auto a = std::make_unique<FaceAssets>();
     a->face = std::move(face);
     a->layout = options.layout;
+
+    auto t = Clock::now();
     a->rig = std::make_unique<expression::FaceRig>(a->face);
-    const std::string dir = data_dir + "/expression/";
+    a->times.rig_ms = ms_since(t);
+
+    t = Clock::now();
     a->emotions = expression::load_emotion_profiles(dir + "emotions.json");
     a->visemes = expression::load_viseme_profiles(dir + "visemes.json");
     std::bitset<expression::kFeatureCount> present;
@@ -23,13 +46,26 @@ std::unique_ptr<FaceAssets> load_face_assets(expression::Face face, const std::s
     a->lines = expression::lines_for_face(expression::load_feature_lines(dir + "feature_lines.json"),
                                           present);
     const expression::WrinkleLibrarySpec spec = expression::load_wrinkle_spec(dir + "wrinkles.json");
-    // Each key at its own expression's full intensity (neutral: no FAPs).
-    for (int k = 0; k < expression::kWrinkleKeyCount; ++k) {
-        expression::FapValues pose{};
-        if (k > 0) pose = a->emotions.profiles[std::size_t(k - 1)];
-        a->keys.push_back(make_wrinkle_key(a->face, *a->rig, spec, expression::WrinkleKey(k), pose,
-                                           options.wrinkle_map_size, options.layout));
+    a->times.profiles_ms = ms_since(t);
+
+    t = Clock::now();
+    if (options.read_keys) {
+        a->keys = options.read_keys(a->lines);
+    } else {
+        // Each key at its own expression's full intensity (neutral: no
+        // FAPs); independent of each other, so made side by side.
+        a->keys.resize(expression::kWrinkleKeyCount);
+        const FaceAssets& shared = *a;
+        parallel_for(expression::kWrinkleKeyCount, 1, [&](int begin, int end) {
+            for (int k = begin; k < end; ++k) {
+                expression::FapValues pose{};
+                if (k > 0) pose = shared.emotions.profiles[std::size_t(k - 1)];
+                a->keys[std::size_t(k)] = make_wrinkle_key(shared.face, *shared.rig, spec, expression::WrinkleKey(k),
+                                                           pose, options.wrinkle_map_size, options.layout);
+            }
+        });
     }
+    a->times.keys_ms = ms_since(t);
     return a;
 }
 
