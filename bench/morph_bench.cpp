@@ -19,8 +19,10 @@
 #include <vector>
 
 #include "bench_inputs.h"
+#include "emoface/common/atomic_file.h"
 #include "emoface/common/error.h"
 #include "emoface/common/parallel.h"
+#include "emoface/common/timing.h"
 #include "emoface/morph/morph.h"
 
 #if defined(EMOFACE_BENCH_CUDA)
@@ -36,7 +38,6 @@ using morph::Accuracy;
 using morph::Backend;
 using morph::Morpher;
 using morph::MorphParams;
-using Clock = std::chrono::steady_clock;
 
 // Processor time of the whole process (all threads), ms: on a loaded
 // machine, wall time overstates what a frame costs; this does not.
@@ -240,7 +241,7 @@ private:
             const auto t0 = Clock::now();
             m[i % 2]->morph_to_host(in.targets[t], in.weights[t], params, out.data());
             cpu.push_back(process_cpu_ms() - c0);
-            return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+            return ms_since(t0);
         };
         const double first = frame(0);
         const int warm = first > 1000.0 ? 0 : std::min(o_.warmup, 2);
@@ -453,9 +454,7 @@ int main(int argc, char** argv) {
         const std::string report = bench.report(command);
         std::printf("%s", report.c_str());
         if (!o.out.empty()) {
-            const std::string tmp = o.out + ".tmp";
-            std::ofstream(tmp) << report;
-            std::rename(tmp.c_str(), o.out.c_str());
+            write_file_atomically(o.out, report, "bench/morph");
         }
     } catch (const std::exception& e) {
         std::fprintf(stderr, "bench/morph: %s\n", e.what());

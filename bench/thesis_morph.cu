@@ -10,6 +10,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "emoface/common/timing.h"
+
 namespace emoface::bench {
 namespace {
 
@@ -18,8 +20,6 @@ void check(cudaError_t e, const char* what) {
 }
 #define THESIS_CHECK(call) check((call), #call)
 
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 // MakeInterpolationGPUKernel: the in-between guide lines.
 __global__ void make_interpolation(const float* lines, const float* weights, int keys, int n, float* target) {

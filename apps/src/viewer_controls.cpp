@@ -5,11 +5,12 @@
 
 #include <glm/geometric.hpp>
 
+#include "emoface/common/constants.h"
+
 namespace emoface::apps {
 
 namespace {
-constexpr float kPi = 3.14159265358979f;
-constexpr float kMaxPitch = 85.0f * kPi / 180.0f;
+constexpr float kMaxPitch = 85.0f * kPiF / 180.0f;
 constexpr float kRadiansPerPixel = 0.008f;
 }  // namespace
 
@@ -47,7 +48,7 @@ void OrbitCamera::orbit(float dx, float dy) {
 void OrbitCamera::pan(float dx, float dy, float height) {
     // One pixel moves the target by the size a pixel has at the target's depth.
     const float per_pixel =
-        2.0f * distance * std::tan(0.5f * fovy_degrees * kPi / 180.0f) / std::max(height, 1.0f);
+        2.0f * distance * std::tan(0.5f * fovy_degrees * kPiF / 180.0f) / std::max(height, 1.0f);
     const glm::vec3 forward = glm::normalize(target - eye());
     const glm::vec3 right = glm::normalize(glm::cross(forward, glm::vec3(0.0f, 1.0f, 0.0f)));
     const glm::vec3 up = glm::cross(right, forward);
@@ -75,8 +76,8 @@ glm::vec4 LightControl::direction() const {
 
 void LightControl::drag(float dx, float dy) {
     azimuth += dx * kRadiansPerPixel;
-    if (azimuth > kPi) azimuth -= 2.0f * kPi;
-    if (azimuth < -kPi) azimuth += 2.0f * kPi;
+    if (azimuth > kPiF) azimuth -= 2.0f * kPiF;
+    if (azimuth < -kPiF) azimuth += 2.0f * kPiF;
     elevation = std::clamp(elevation - dy * kRadiansPerPixel, -kMaxPitch, kMaxPitch);
 }
 

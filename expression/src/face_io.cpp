@@ -11,8 +11,8 @@
 #include <sstream>
 
 #include <nlohmann/json.hpp>
-#include <unistd.h>
 
+#include "emoface/common/atomic_file.h"
 #include "emoface/common/error.h"
 #include "emoface/fap/feature_points.h"
 #include "json_reader.h"
@@ -34,27 +34,6 @@ std::string stem_of(const std::string& path) {
     std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
     const auto dot = name.find_last_of('.');
     return dot == std::string::npos ? name : name.substr(0, dot);
-}
-
-// Writes `bytes` to a temporary file beside `path`, then renames it over path.
-void write_atomically(const std::string& path, const std::string& bytes) {
-    static int counter = 0;
-    const std::string tmp = path + ".tmp" + std::to_string(::getpid()) + "_" + std::to_string(counter++);
-    {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        if (!out) fail<InputError>("expression: cannot write {}: {}", path, std::strerror(errno));
-        out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-        out.close();
-        if (!out) {
-            std::remove(tmp.c_str());
-            fail<InputError>("expression: cannot write {}: {}", path, std::strerror(errno));
-        }
-    }
-    if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-        const int err = errno;
-        std::remove(tmp.c_str());
-        fail<InputError>("expression: cannot write {}: {}", path, std::strerror(err));
-    }
 }
 
 std::string read_text(const std::string& path) {
@@ -209,12 +188,13 @@ void save_obj(const Face& face, const std::string& path, const std::string& mate
         }
         out += '\n';
     }
-    write_atomically(path, out);
+    write_file_atomically(path, out, "expression");
 }
 
 void save_mtl(const std::string& path, const std::string& texture_file) {
-    write_atomically(path, fmt::format("newmtl face\nKa 0 0 0\nKd 1 1 1\nKs 0.05 0.05 0.05\nNs 20\nmap_Kd {}\n",
-                                       texture_file));
+    write_file_atomically(
+        path, fmt::format("newmtl face\nKa 0 0 0\nKd 1 1 1\nKs 0.05 0.05 0.05\nNs 20\nmap_Kd {}\n", texture_file),
+        "expression");
 }
 
 void save_fdp(const Face& face, const std::string& path, const std::string& mesh_file,
@@ -262,7 +242,7 @@ void save_fdp(const Face& face, const std::string& path, const std::string& mesh
     j["head_pivot"] = vec_json(face.head_pivot);
     j["texture_box"] = {{"min", {face.texture_box.min.x, face.texture_box.min.y}},
                         {"max", {face.texture_box.max.x, face.texture_box.max.y}}};
-    write_atomically(path, j.dump(1) + "\n");
+    write_file_atomically(path, j.dump(1) + "\n", "expression");
 }
 
 Face load_obj_with_fdp(const std::string& obj_path, const std::string& fdp_path) {
@@ -650,7 +630,7 @@ void save_png(const Image& image, const std::string& path) {
     be32(z, (b << 16) | a);
     chunk("IDAT", z);
     chunk("IEND", "");
-    write_atomically(path, out);
+    write_file_atomically(path, out, "expression");
 }
 
 }  // namespace emoface::expression

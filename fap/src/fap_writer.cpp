@@ -1,15 +1,9 @@
 // The ASCII FAP writer: writes exactly what fap_reader.cpp reads back.
-#include <cerrno>
 #include <cmath>
-#include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <string>
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
+#include "emoface/common/atomic_file.h"
 #include "emoface/common/error.h"
 #include "emoface/fap/fap_io.h"
 #include "text.h"
@@ -104,32 +98,7 @@ std::string format_fap(const FapStream& s) {
 
 void write_fap_file(const FapStream& stream, const std::string& path) {
     const std::string text = format_fap(stream);
-    // A temporary file in the same folder, renamed over path once complete,
-    // so no reader ever sees half a file.
-    std::string temp = path + ".tmp-XXXXXX";
-    const int fd = ::mkstemp(temp.data());
-    if (fd < 0)
-        fail<InputError>("fap: {}: expected a writable folder, found {}", path, std::strerror(errno));
-    std::size_t written = 0;
-    while (written < text.size()) {
-        const ssize_t n = ::write(fd, text.data() + written, text.size() - written);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) {
-            const int err = errno;
-            ::close(fd);
-            ::unlink(temp.c_str());
-            fail<InputError>("fap: {}: expected to write {} bytes, found {}", path, text.size(),
-                             std::strerror(err));
-        }
-        written += static_cast<std::size_t>(n);
-    }
-    // mkstemp creates the file 0600; give it the usual permissions.
-    ::fchmod(fd, 0644);
-    if (::close(fd) != 0 || std::rename(temp.c_str(), path.c_str()) != 0) {
-        const int err = errno;
-        ::unlink(temp.c_str());
-        fail<InputError>("fap: {}: expected to replace the file, found {}", path, std::strerror(err));
-    }
+    write_file_atomically(path, text, "fap");
 }
 
 bool same_content(const FapStream& a, const FapStream& b) {

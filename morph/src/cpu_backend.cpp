@@ -8,6 +8,7 @@
 #include "backend.h"
 #include "cpu_kernels.h"
 #include "emoface/common/parallel.h"
+#include "emoface/common/timing.h"
 
 namespace emoface::morph::detail {
 namespace {
@@ -22,11 +23,6 @@ const CpuKernels& pick_kernels() {
     if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return cpu_avx2::kernels();
 #endif
     return cpu_base::kernels();
-}
-
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
 class CpuBackend final : public BackendImpl {

@@ -3,12 +3,12 @@
 #include <algorithm>
 #include <cmath>
 
+#include "emoface/common/constants.h"
 #include "emoface/common/error.h"
 
 namespace emoface::render::detail {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // The ring integrals of one Gaussian of the profile, for a point whose normal
 // makes angle theta with the light on a circle of radius r (mm): numerator

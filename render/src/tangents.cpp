@@ -7,6 +7,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "emoface/common/constants.h"
 #include "emoface/common/error.h"
 #include "emoface/common/parallel.h"
 
@@ -41,7 +42,7 @@ float fast_acos(float x) {
     const float a = std::fabs(x);
     float r = ((-0.0187293f * a + 0.0742610f) * a - 0.2121144f) * a + 1.5707288f;
     r *= std::sqrt(1.0f - a);
-    return x < 0 ? 3.14159265f - r : r;
+    return x < 0 ? kPiF - r : r;
 }
 
 }  // namespace

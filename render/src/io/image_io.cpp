@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <vector>
 
-#include "atomic_file.h"
+#include "emoface/common/atomic_file.h"
 #include "emoface/common/error.h"
 
 namespace emoface::render {
@@ -21,7 +21,7 @@ void check_image(const std::string& path, const Image& image) {
 
 void write_pixels(const std::string& path, int width, int height, OIIO::TypeDesc in_type,
                   OIIO::TypeDesc file_type, const void* pixels) {
-    const std::string temp = detail::temporary_path_for(path);
+    const std::string temp = temporary_path_for(path);
     auto out = OIIO::ImageOutput::create(path);  // format from the real name
     if (!out)
         fail<InputError>("render: {}: no image format for this extension ({})", path,
@@ -31,7 +31,7 @@ void write_pixels(const std::string& path, int width, int height, OIIO::TypeDesc
     spec.attribute("oiio:UnassociatedAlpha", 1);
     if (!out->open(temp, spec)) {
         const std::string why = out->geterror();
-        detail::discard_temporary(temp);
+        discard_temporary(temp);
         fail("render: {}: cannot open for writing: {}", path, why);
     }
     const bool wrote = out->write_image(in_type, pixels);
@@ -39,11 +39,11 @@ void write_pixels(const std::string& path, int width, int height, OIIO::TypeDesc
     if (!wrote || !closed) {
         const std::string why = out->geterror();
         out.reset();
-        detail::discard_temporary(temp);
+        discard_temporary(temp);
         fail("render: {}: writing failed: {}", path, why);
     }
     out.reset();
-    detail::commit_temporary(temp, path);
+    commit_temporary(temp, path, "render");
 }
 
 template <typename T>

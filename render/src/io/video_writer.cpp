@@ -9,7 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "atomic_file.h"
+#include "emoface/common/atomic_file.h"
 #include "emoface/common/error.h"
 #include "emoface/render/image_io.h"
 
@@ -46,23 +46,23 @@ VideoWriter::VideoWriter(const std::string& path, int width, int height, double 
     if (ext == ".mp4") {
         // H.264 under the fourcc names OpenCV's FFmpeg backend accepts.
         for (const char* fourcc : {"avc1", "H264", "X264"}) {
-            temp_path_ = detail::temporary_path_for(path_);
+            temp_path_ = temporary_path_for(path_);
             const int code = cv::VideoWriter::fourcc(fourcc[0], fourcc[1], fourcc[2], fourcc[3]);
             if (impl_->writer.open(temp_path_, cv::CAP_FFMPEG, code, fps, size, true)) {
                 codec_ = "H.264";
                 return;
             }
-            detail::discard_temporary(temp_path_);
+            discard_temporary(temp_path_);
         }
         path_ = std::filesystem::path(path_).replace_extension(".avi").string();
     }
-    temp_path_ = detail::temporary_path_for(path_);
+    temp_path_ = temporary_path_for(path_);
     const int mjpg = cv::VideoWriter::fourcc('M', 'J', 'P', 'G');
     if (impl_->writer.open(temp_path_, mjpg, fps, size, true)) {
         codec_ = "MJPG";
         return;
     }
-    detail::discard_temporary(temp_path_);
+    discard_temporary(temp_path_);
     fail<EnvironmentError>("render: {}: OpenCV's VideoWriter has neither an H.264 nor an MJPG "
                            "encoder here",
                            path);
@@ -71,7 +71,7 @@ VideoWriter::VideoWriter(const std::string& path, int width, int height, double 
 VideoWriter::~VideoWriter() {
     if (impl_ && impl_->writer.isOpened()) {
         impl_->writer.release();
-        detail::discard_temporary(temp_path_);
+        discard_temporary(temp_path_);
     }
 }
 
@@ -93,10 +93,10 @@ std::string VideoWriter::close() {
     std::error_code ec;
     const auto size = std::filesystem::file_size(temp_path_, ec);
     if (ec || size == 0) {
-        detail::discard_temporary(temp_path_);
+        discard_temporary(temp_path_);
         fail("render: {}: the encoder wrote nothing", path_);
     }
-    detail::commit_temporary(temp_path_, path_);
+    commit_temporary(temp_path_, path_, "render");
     return path_;
 }
 
