@@ -101,6 +101,13 @@ void Platform::destroy_gl() {
     draw_fbo_ = resolve_fbo_ = draw_color_ = draw_depth_ = resolve_color_ = 0;
 }
 
+void Platform::close_gl() {
+    make_current();
+    destroy_gl();
+    unbind_context();
+    forget_current();
+}
+
 void Platform::begin_frame() {
     glBindFramebuffer(GL_FRAMEBUFFER, draw_fbo_);
     glViewport(0, 0, width_, height_);
@@ -140,17 +147,6 @@ ImageRGBA8 Platform::read_rgba() const {
     ImageRGBA8 out;
     read_rgba(out);
     return out;
-}
-
-std::unique_ptr<Platform> open_platform(PlatformKind kind, const PlatformOptions& options) {
-    if (kind == PlatformKind::Auto) {
-        const char* display = std::getenv("DISPLAY");
-        const char* wayland = std::getenv("WAYLAND_DISPLAY");
-        const bool has_display = (display && *display) || (wayland && *wayland);
-        kind = has_display ? PlatformKind::Window : PlatformKind::Headless;
-    }
-    if (kind == PlatformKind::Window) return std::make_unique<WindowPlatform>(options);
-    return std::make_unique<HeadlessPlatform>(options);
 }
 
 }  // namespace emoface::render

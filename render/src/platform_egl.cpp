@@ -185,10 +185,7 @@ HeadlessPlatform::HeadlessPlatform(const PlatformOptions& options) {
 
 HeadlessPlatform::~HeadlessPlatform() {
     if (!context_) return;
-    make_current();
-    destroy_gl();
-    unbind_context();
-    forget_current();
+    close_gl();
     eglDestroyContext(display_, context_);
     release_display(display_);
 }

@@ -78,10 +78,7 @@ WindowPlatform::WindowPlatform(const PlatformOptions& options) {
 
 WindowPlatform::~WindowPlatform() {
     if (!window_) return;
-    make_current();
-    destroy_gl();
-    unbind_context();
-    forget_current();
+    close_gl();
     glfwDestroyWindow(window_);
     release_glfw();
 }

@@ -8,10 +8,6 @@
 //    through WM_DELETE_WINDOW, and its --screenshot matches what the X server
 //    shows in the window.
 // Without Xvfb installed the windowed cases skip with a message.
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -29,10 +25,13 @@
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
+#include "emoface/render/image_diff.h"
 #include "emoface/render/image_io.h"
 #include "emoface/render/renderer.h"
 #include "viewer_controls.h"
-#include "viewer_x11.h"
+#include "support/run_emoface.h"
+#include "support/scratch_dir.h"
+#include "support/x11_display.h"
 
 namespace {
 
@@ -143,79 +142,33 @@ TEST(ViewerControls, LightKeepsItsDirectionAndDragsAroundTheFace) {
 
 // --- emoface view end to end ---------------------------------------------------------
 
-struct Result {
-    int rc;
-    std::string err;
-};
+using emoface::testing::CommandResult;
+using emoface::testing::EmofaceProcess;
+using emoface::testing::RunOptions;
+using emoface::testing::run_emoface;
 
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
+RunOptions without_display() {
+    RunOptions o;
+    o.unset_env = {"DISPLAY"};
+    return o;
 }
-
-// The binary keeps ASan's checks but not LeakSanitizer's: GL drivers keep
-// one-time allocations past exit.
-std::string command_line(const std::string& args, const fs::path& err) {
-    return "ASAN_OPTIONS=\"${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0\" '" + std::string(EMOFACE_BINARY) +
-           "' " + args + " >/dev/null 2>'" + err.string() + "'";
+RunOptions on_display(const std::string& display) {
+    RunOptions o;
+    o.set_env = {{"DISPLAY", display}};
+    return o;
 }
 
 class ViewCommand : public ::testing::Test {
 protected:
-    void SetUp() override {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        dir_ = fs::temp_directory_path() / ("emoface_viewer_" + std::to_string(::getpid()) + "_" + info->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
+    std::string path(const std::string& name) const { return scratch_.path(name); }
 
-    // Runs `emoface ARGS` to the end with `env` before it ("env -u DISPLAY").
-    Result run(const std::string& args, const std::string& env) {
-        const fs::path err = dir_ / "stderr";
-        const int status = std::system((env + " " + command_line(args, err)).c_str());
-        return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(err)};
-    }
-
-    // Starts `emoface ARGS` on `display` without waiting for it.
-    pid_t start(const std::string& args, const std::string& display) {
-        const std::string cmd = command_line(args, dir_ / "stderr");
-        const pid_t pid = ::fork();
-        if (pid == 0) {
-            ::setenv("DISPLAY", display.c_str(), 1);
-            ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
-            ::_exit(127);
-        }
-        return pid;
-    }
-
-    // The exit code of a started command; killed (and -1) after `seconds`.
-    static int finish(pid_t pid, double seconds) {
-        const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(long(seconds * 1000));
-        int status = 0;
-        while (::waitpid(pid, &status, WNOHANG) == 0) {
-            if (std::chrono::steady_clock::now() > deadline) {
-                ::kill(pid, SIGKILL);
-                ::waitpid(pid, &status, 0);
-                return -1;
-            }
-            std::this_thread::sleep_for(std::chrono::milliseconds(50));
-        }
-        return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    }
-
-    std::string path(const std::string& name) const { return (dir_ / name).string(); }
-    std::string err() const { return slurp(dir_ / "stderr"); }
-
-    fs::path dir_;
+    emoface::testing::ScratchDir scratch_;
 };
 
 TEST_F(ViewCommand, WithoutADisplayExits3NamingTheFix) {
     const std::string shot = path("shot.png");
-    const Result r = run("view --quit-after 3 --screenshot '" + shot + "'", "env -u DISPLAY");
-    EXPECT_EQ(r.rc, 3) << r.err;
+    const CommandResult r = run_emoface({"view", "--quit-after", "3", "--screenshot", shot}, without_display());
+    EXPECT_EQ(r.exit_code, 3) << r.err;
     EXPECT_NE(r.err.find("DISPLAY is not set"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("xvfb-run -a emoface view"), std::string::npos) << "names the fix: " << r.err;
     EXPECT_NE(r.err.find("emoface play FILE.fap --out"), std::string::npos) << r.err;
@@ -225,37 +178,39 @@ TEST_F(ViewCommand, WithoutADisplayExits3NamingTheFix) {
 
 TEST_F(ViewCommand, BadInputExits2BeforeLookingForADisplay) {
     struct Case {
-        std::string args, message;
+        std::vector<std::string> args;
+        std::string message;
     };
     const Case cases[] = {
-        {"'" + path("missing.fap") + "'", "missing.fap"},
-        {"--mix '0.8 anger + 0.4 fear'", "emotion mix"},
-        {"--mix 'rage'", "rage"},
-        {"--size 10x10", "--size"},
-        {"--backend gpu", "--backend 'gpu'"},
-        {"--wrinkle-size 100", "--wrinkle-size 100"},
-        {"--screenshot '" + path("no/such/folder/shot.png") + "'", "no/such/folder"},
+        {{path("missing.fap")}, "missing.fap"},
+        {{"--mix", "0.8 anger + 0.4 fear"}, "emotion mix"},
+        {{"--mix", "rage"}, "rage"},
+        {{"--size", "10x10"}, "--size"},
+        {{"--backend", "gpu"}, "--backend 'gpu'"},
+        {{"--wrinkle-size", "100"}, "--wrinkle-size 100"},
+        // A missing folder is made; a file in the way is bad input.
+        {{"--screenshot", scratch_.write("blocker", "a file") + "/shot.png"}, "is a file, not a folder"},
     };
     for (const Case& c : cases) {
         // No display either: exit 2 (not 3) shows the input is checked first.
-        const Result r = run("view " + c.args, "env -u DISPLAY");
-        EXPECT_EQ(r.rc, 2) << c.args << ": " << r.err;
-        EXPECT_NE(r.err.find(c.message), std::string::npos) << c.args << ": " << r.err;
+        const CommandResult r = run_emoface(emoface::testing::args_with({"view"}, c.args), without_display());
+        EXPECT_EQ(r.exit_code, 2) << c.message << ": " << r.err;
+        EXPECT_NE(r.err.find(c.message), std::string::npos) << c.message << ": " << r.err;
     }
 }
 
 // A private X server for the windowed cases, shared by them.
 class ViewUnderXvfb : public ViewCommand {
 protected:
-    static void SetUpTestSuite() { xvfb_ = std::make_unique<emoface::apps::testing::VirtualDisplay>(1280, 1024); }
+    static void SetUpTestSuite() { xvfb_ = std::make_unique<emoface::testing::VirtualDisplay>(1280, 1024); }
     static void TearDownTestSuite() { xvfb_.reset(); }
     void SetUp() override {
         ViewCommand::SetUp();
         if (xvfb_->name().empty()) GTEST_SKIP() << "no virtual X server: " << xvfb_->why();
     }
-    static std::unique_ptr<emoface::apps::testing::VirtualDisplay> xvfb_;
+    static std::unique_ptr<emoface::testing::VirtualDisplay> xvfb_;
 };
-std::unique_ptr<emoface::apps::testing::VirtualDisplay> ViewUnderXvfb::xvfb_;
+std::unique_ptr<emoface::testing::VirtualDisplay> ViewUnderXvfb::xvfb_;
 
 int distinct_colours(const ImageRGBA8& img) {
     std::set<std::uint32_t> colours;
@@ -267,12 +222,17 @@ int distinct_colours(const ImageRGBA8& img) {
 // The feature points' dots: saturated red no part of the face has.
 bool is_dot(const std::uint8_t* rgb) { return rgb[0] > 230 && rgb[1] < 90 && rgb[2] < 80; }
 
-TEST_F(ViewUnderXvfb, RendersFramesAndClosesOnItsOwn) {
+// `view FILE`, and `play FILE` without --out, which opens the same viewer
+// with the options given (here the lighter face's).
+class ViewOrPlayUnderXvfb : public ViewUnderXvfb, public ::testing::WithParamInterface<const char*> {};
+
+TEST_P(ViewOrPlayUnderXvfb, RendersFramesAndClosesOnItsOwn) {
     const std::string shot = path("shot.png");
-    const Result r = run("view '" EMOFACE_DATA_DIR "/fap/tour.fap' --size 480x360 --wrinkle-size 256 --quit-after 3 "
-                         "--screenshot '" + shot + "'",
-                         "DISPLAY=" + xvfb_->name());
-    ASSERT_EQ(r.rc, 0) << r.err;
+    const CommandResult r = run_emoface({GetParam(), EMOFACE_DATA_DIR "/fap/tour.fap", "--size", "480x360",
+                                         "--wrinkle-size", "256", "--face-resolution", "0.5", "--quit-after", "3",
+                                         "--screenshot", shot},
+                                        on_display(xvfb_->name()));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
     const ImageRGBA8 img = emoface::render::read_image_rgba8(shot);
     EXPECT_EQ(img.width, 480);
     EXPECT_EQ(img.height, 360);
@@ -289,16 +249,17 @@ TEST_F(ViewUnderXvfb, RendersFramesAndClosesOnItsOwn) {
     EXPECT_LT(dots, 10) << "feature points are off unless asked for";
     EXPECT_FALSE(fs::exists(path("imgui.ini"))) << "no settings file left behind";
 }
+INSTANTIATE_TEST_SUITE_P(Commands, ViewOrPlayUnderXvfb, ::testing::Values("view", "play"));
 
 // What the X server shows in the viewer's window once it is loaded (the
 // title says "loading" until then), taken when three grabs over a second
 // agree: the picture settled (nothing moves in a view of a still mix).
-bool settled_grab(const std::string& display, double seconds, emoface::apps::testing::WindowShot& grab) {
-    emoface::apps::testing::WindowShot previous;
+bool settled_grab(const std::string& display, double seconds, emoface::testing::WindowShot& grab) {
+    emoface::testing::WindowShot previous;
     int agreeing = 0;
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(long(seconds * 1000));
     while (agreeing < 3 && std::chrono::steady_clock::now() < deadline) {
-        if (!emoface::apps::testing::grab_window(display, "emoface view", "loading", 1.0, grab)) continue;
+        if (!emoface::testing::grab_window(display, "emoface view", "loading", 1.0, grab)) continue;
         agreeing = !previous.rgb.empty() && previous.rgb == grab.rgb ? agreeing + 1 : 1;
         previous = grab;
         std::this_thread::sleep_for(std::chrono::milliseconds(500));
@@ -306,14 +267,14 @@ bool settled_grab(const std::string& display, double seconds, emoface::apps::tes
     return agreeing >= 3;
 }
 
-int count_dots(const emoface::apps::testing::WindowShot& grab) {
+int count_dots(const emoface::testing::WindowShot& grab) {
     int dots = 0;
     for (std::size_t i = 0; i < grab.rgb.size(); i += 3) dots += is_dot(&grab.rgb[i]);
     return dots;
 }
 
 // Pixels of the background's colour (0.16, 0.17, 0.19 sRGB).
-int count_background(const emoface::apps::testing::WindowShot& grab) {
+int count_background(const emoface::testing::WindowShot& grab) {
     int n = 0;
     for (std::size_t i = 0; i < grab.rgb.size(); i += 3)
         n += std::abs(grab.rgb[i] - 41) <= 2 && std::abs(grab.rgb[i + 1] - 43) <= 2 &&
@@ -321,31 +282,26 @@ int count_background(const emoface::apps::testing::WindowShot& grab) {
     return n;
 }
 
-double fraction_differing(const emoface::apps::testing::WindowShot& a, const emoface::apps::testing::WindowShot& b) {
-    if (a.rgb.size() != b.rgb.size() || a.rgb.empty()) return 1.0;
-    std::size_t n = 0;
-    for (std::size_t i = 0; i < a.rgb.size(); i += 3)
-        n += std::abs(a.rgb[i] - b.rgb[i]) > 8 || std::abs(a.rgb[i + 1] - b.rgb[i + 1]) > 8 ||
-             std::abs(a.rgb[i + 2] - b.rgb[i + 2]) > 8;
-    return double(n) / double(a.rgb.size() / 3);
+// The fraction of pixels that differ by more than 8 on some channel (of
+// those in the box [x0, x1) x [y0, y1) when one is given).
+double fraction_differing(const ImageRGBA8& a, const ImageRGBA8& b, int x0 = 0, int y0 = 0, int x1 = -1,
+                          int y1 = -1) {
+    emoface::render::ImageDiffOptions options;
+    options.pixel_tolerance = 8;
+    if (x1 >= 0) options.mask = emoface::render::box_mask(a.width, a.height, x0, y0, x1, y1);
+    return emoface::render::diff_images(a, b, options).failing_fraction();
 }
 
 TEST_F(ViewUnderXvfb, TheWindowFollowsTheMouseAndClosesWhenAsked) {
-    namespace x = emoface::apps::testing;
+    namespace x = emoface::testing;
     const std::string shot = path("shot.png");
-    const pid_t pid = start("view --mix '0.7 anger + 0.3 fear' --points --lines --size 480x360 --wrinkle-size 256 "
-                            "--screenshot '" + shot + "'",
-                            xvfb_->name());
-    ASSERT_GT(pid, 0);
-    struct Stop {  // never leave the viewer running after a failed assertion
-        pid_t pid;
-        ~Stop() { ViewCommand::finish(pid, 0); }
-    };
+    // Killed when it goes out of scope: never left running after a failed assertion.
+    EmofaceProcess viewer({"view", "--mix", "0.7 anger + 0.3 fear", "--points", "--lines", "--size", "480x360",
+                           "--wrinkle-size", "256", "--screenshot", shot},
+                          on_display(xvfb_->name()));
     x::WindowShot frontal;
-    if (!settled_grab(xvfb_->name(), 120, frontal)) {
-        Stop{pid};
-        FAIL() << "no settled viewer window within 120 s: " << err();
-    }
+    if (!settled_grab(xvfb_->name(), 120, frontal))
+        FAIL() << "no settled viewer window within 120 s: " << viewer.err_so_far();
     EXPECT_EQ(frontal.title, "emoface view: emotion mix");
     ASSERT_EQ(frontal.width, 480);
     ASSERT_EQ(frontal.height, 360);
@@ -354,43 +310,94 @@ TEST_F(ViewUnderXvfb, TheWindowFollowsTheMouseAndClosesWhenAsked) {
     // Left-drag across the face (below the folded panel) orbits the camera.
     x::WindowShot orbited;
     ASSERT_TRUE(x::drag(xvfb_->name(), "emoface view", 1, 280, 200, 380, 200, 4, 500));
-    ASSERT_TRUE(settled_grab(xvfb_->name(), 60, orbited)) << err();
-    EXPECT_GT(fraction_differing(frontal, orbited), 0.05) << "the face turned";
+    ASSERT_TRUE(settled_grab(xvfb_->name(), 60, orbited)) << viewer.err_so_far();
+    EXPECT_GT(fraction_differing(frontal.image(), orbited.image()), 0.05) << "the face turned";
     EXPECT_GT(count_dots(orbited), 50) << "the feature points follow the turned face";
 
     // Wheel up zooms in: the face covers more of the window.
     x::WindowShot zoomed;
     ASSERT_TRUE(x::scroll(xvfb_->name(), "emoface view", 280, 200, 3, 500));
-    ASSERT_TRUE(settled_grab(xvfb_->name(), 60, zoomed)) << err();
+    ASSERT_TRUE(settled_grab(xvfb_->name(), 60, zoomed)) << viewer.err_so_far();
     EXPECT_LT(count_background(zoomed), count_background(orbited) * 8 / 10) << "zoomed in";
 
     ASSERT_TRUE(x::request_close(xvfb_->name(), "emoface view"));
-    EXPECT_EQ(ViewCommand::finish(pid, 60), 0) << "closes when the window manager asks: " << err();
+    const CommandResult closed = viewer.wait(60);
+    EXPECT_EQ(closed.exit_code, 0) << "closes when the window manager asks: " << closed.err;
 
     // The screenshot is the frame the window showed last.
     const ImageRGBA8 img = emoface::render::read_image_rgba8(shot);
     ASSERT_EQ(img.width, zoomed.width);
     ASSERT_EQ(img.height, zoomed.height);
-    int same = 0;
-    for (int y = 0; y < img.height; ++y)
-        for (int x = 0; x < img.width; ++x) {
-            const std::uint8_t* s = img.at(x, y);
-            const std::uint8_t* g = &zoomed.rgb[(std::size_t(y) * std::size_t(zoomed.width) + std::size_t(x)) * 3];
-            same += std::abs(s[0] - g[0]) <= 2 && std::abs(s[1] - g[1]) <= 2 && std::abs(s[2] - g[2]) <= 2;
-        }
-    EXPECT_GT(same, img.width * img.height * 99 / 100) << "screenshot and window agree";
+    emoface::render::ImageDiffOptions within_two;
+    within_two.pixel_tolerance = 2;
+    EXPECT_LT(emoface::render::diff_images(img, zoomed.image(), within_two).failing_fraction(), 0.01)
+        << "screenshot and window agree";
     if (::testing::Test::HasFailure() || std::getenv("EMOFACE_KEEP_VIEWER_SHOTS")) {
         // The pictures in the working folder, to look at.
         for (const auto* g : {&frontal, &orbited, &zoomed}) {
-            ImageRGBA8 window(g->width, g->height);
-            for (std::size_t i = 0; i < std::size_t(g->width) * std::size_t(g->height); ++i) {
-                std::copy_n(&g->rgb[3 * i], 3, &window.pixels[4 * i]);
-                window.pixels[4 * i + 3] = 255;
-            }
             const char* name = g == &frontal ? "frontal" : g == &orbited ? "orbited" : "zoomed";
-            emoface::render::write_image(std::string("viewer_test_") + name + ".png", window);
+            emoface::render::write_image(std::string("viewer_test_") + name + ".png", g->image());
         }
         fs::copy_file(shot, "viewer_test_screenshot.png", fs::copy_options::overwrite_existing);
+    }
+}
+
+// --- play and mix open the viewer with every session option ---------------------
+
+// Pixels of `rgb` within 6 of `colour` on each channel.
+int count_colour(const ImageRGBA8& img, const std::array<int, 3>& colour) {
+    int n = 0;
+    for (std::size_t i = 0; i + 3 < img.pixels.size(); i += 4)
+        n += std::abs(img.pixels[i] - colour[0]) <= 6 && std::abs(img.pixels[i + 1] - colour[1]) <= 6 &&
+             std::abs(img.pixels[i + 2] - colour[2]) <= 6;
+    return n;
+}
+
+// The acceptance case of the viewer's options: `mix MIX` without --out opens
+// the viewer on the key maps of --wrinkles DIR (an artist's folder), not on
+// generated ones. The anger key is painted one tilted normal everywhere, so
+// at full anger the morphed map is that colour: the panel's wrinkle-map
+// preview shows it, and the face is lit by it.
+TEST_F(ViewUnderXvfb, MixWithoutOutShowsThePaintedWrinkleMaps) {
+    const std::string generated = path("generated"), painted = path("painted");
+    CommandResult r = run_emoface({"wrinkles", "--size", "256", "--out", generated});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    fs::copy(generated, painted);
+    // n = (0.6, 0, 0.8): RGB = 0.5 + 0.5 n, a colour no generated map has
+    // over a large area.
+    const std::array<int, 3> tilted{204, 128, 230};
+    ImageRGBA8 anger(256, 256);
+    for (int y = 0; y < 256; ++y)
+        for (int x = 0; x < 256; ++x) {
+            std::uint8_t* p = anger.at(x, y);
+            p[0] = std::uint8_t(tilted[0]), p[1] = std::uint8_t(tilted[1]), p[2] = std::uint8_t(tilted[2]), p[3] = 255;
+        }
+    emoface::render::write_image(painted + "/anger.png", anger);
+
+    // Every session option goes through to the viewer (a coarse face, small
+    // textures, one sample: fast under llvmpipe).
+    auto show = [&](const std::string& keys, const std::string& shot) {
+        return run_emoface({"mix", "anger", "--wrinkles", keys, "--wrinkle-map", "--size", "1200x1000",
+                            "--face-resolution", "0.5", "--texture-size", "256", "--samples", "1", "--backend",
+                            "cpu", "--quit-after", "4", "--screenshot", shot},
+                           on_display(xvfb_->name()));
+    };
+    r = show(painted, path("painted.png"));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    r = show(generated, path("generated.png"));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const ImageRGBA8 with_painted = emoface::render::read_image_rgba8(path("painted.png"));
+    const ImageRGBA8 with_generated = emoface::render::read_image_rgba8(path("generated.png"));
+    ASSERT_EQ(with_painted.width, 1200);
+    ASSERT_EQ(with_painted.height, 1000);
+    // The preview (about 360 x 360 in the panel) shows the painted colour.
+    EXPECT_GT(count_colour(with_painted, tilted), 40000) << "the painted map in the panel's preview";
+    EXPECT_LT(count_colour(with_generated, tilted), 4000) << "generated keys look otherwise";
+    // The face in the middle (right of the panel) is lit by the painted map.
+    EXPECT_GT(fraction_differing(with_painted, with_generated, 520, 400, 680, 600), 0.3);
+    if (::testing::Test::HasFailure() || std::getenv("EMOFACE_KEEP_VIEWER_SHOTS")) {
+        fs::copy_file(path("painted.png"), "viewer_test_painted.png", fs::copy_options::overwrite_existing);
+        fs::copy_file(path("generated.png"), "viewer_test_generated.png", fs::copy_options::overwrite_existing);
     }
 }
 

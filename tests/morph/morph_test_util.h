@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "emoface/morph/morph.h"
+#include "support/parity.h"
 
 namespace emoface::morph::test {
 
@@ -111,12 +112,7 @@ inline RandomKeys random_keys(int w, int h, int count, PixelFormat format, bool 
     return r;
 }
 
-template <class T>
-inline double max_abs_diff(const std::vector<T>& a, const std::vector<T>& b) {
-    double m = 0.0;
-    for (std::size_t i = 0; i < a.size(); ++i)
-        m = std::fmax(m, std::fabs(static_cast<double>(a[i]) - static_cast<double>(b[i])));
-    return m;
-}
+// Fails on NaN and on a size mismatch (tests/support/parity.h).
+using emoface::testing::max_abs_diff;
 
 }  // namespace emoface::morph::test

@@ -1,13 +1,12 @@
 #include "golden.h"
 
-#include <algorithm>
-#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 
 #include <fmt/format.h>
 
 #include "emoface/common/error.h"
+#include "emoface/render/image_diff.h"
 #include "emoface/render/image_io.h"
 
 namespace emoface::render::testing {
@@ -55,30 +54,13 @@ GoldenResult compare_with_golden(const ImageRGBA8& actual, const std::string& go
                                 actual_path);
         return r;
     }
-    ImageRGBA8 diff(actual.width, actual.height);
-    double sum = 0.0;
-    for (int y = 0; y < actual.height; ++y)
-        for (int x = 0; x < actual.width; ++x) {
-            int pixel_max = 0;
-            for (int c = 0; c < 3; ++c) {
-                const int d = std::abs(int(actual.at(x, y)[c]) - int(golden.at(x, y)[c]));
-                pixel_max = std::max(pixel_max, d);
-                sum += d;
-            }
-            r.max_channel_diff = std::max(r.max_channel_diff, pixel_max);
-            // Differences amplified 8x in red over a dimmed copy of the golden.
-            std::uint8_t* out = diff.at(x, y);
-            const std::uint8_t* g = golden.at(x, y);
-            out[0] = std::uint8_t(std::min(255, g[0] / 4 + pixel_max * 8));
-            out[1] = std::uint8_t(g[1] / 4);
-            out[2] = std::uint8_t(g[2] / 4);
-            out[3] = 255;
-        }
-    r.mean_diff = sum / (3.0 * actual.width * actual.height);
+    const ImageDiff diff = diff_images(actual, golden);
+    r.max_channel_diff = diff.max_channel_diff;
+    r.mean_diff = diff.mean_diff;
     r.ok = r.max_channel_diff <= tolerance.max_channel_diff && r.mean_diff <= tolerance.mean_diff;
     if (!r.ok) {
         write_image(actual_path, actual);
-        write_image(diff_path, diff);
+        write_image(diff_path, diff.visual);
         r.message = fmt::format(
             "{}: max channel difference {} (allowed {}), mean {:.3f} (allowed {}); tolerance: "
             "{}; actual image {}, difference {}",

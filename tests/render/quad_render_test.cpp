@@ -5,6 +5,7 @@
 // decoded normal brought to world space through T, B = w N x T, N, encoded
 // to sRGB. The skin model is checked for its properties on the same quad:
 // energy bounded, Fresnel rising at grazing angles, a monotonic tone curve.
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <iterator>
@@ -21,6 +22,7 @@
 #include "emoface/render/renderer.h"
 #include "emoface/render/skin_shading.h"
 #include "emoface/render/wrinkle_texture.h"
+#include "quad_mesh.h"
 
 namespace {
 
@@ -80,21 +82,13 @@ glm::vec3 dpdv(UvLayout layout) {
     return layout == UvLayout::VUp ? glm::vec3(0, 1, 0) : glm::vec3(0, -1, 0);
 }
 
+// The quad spans [-1, 1]^2 at z = 0, facing +z.
 TriMesh make_quad(UvLayout layout) {
-    TriMesh m;
-    m.request_vertex_normals();
-    m.request_vertex_texcoords2D();
-    const float xy[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
-    TriMesh::VertexHandle v[4];
-    for (int i = 0; i < 4; ++i) {
-        v[i] = m.add_vertex({xy[i][0], xy[i][1], 0.0f});
-        m.set_normal(v[i], {0, 0, 1});
-        const glm::vec2 uv = base_uv(layout, xy[i][0], xy[i][1]);
-        m.set_texcoord2D(v[i], {uv.x, uv.y});
-    }
-    m.add_face(v[0], v[1], v[2]);
-    m.add_face(v[0], v[2], v[3]);
-    return m;
+    const std::array<glm::vec3, 4> corners = {glm::vec3(-1, -1, 0), glm::vec3(1, -1, 0), glm::vec3(1, 1, 0),
+                                              glm::vec3(-1, 1, 0)};
+    std::array<glm::vec2, 4> uvs;
+    for (int i = 0; i < 4; ++i) uvs[i] = base_uv(layout, corners[i].x, corners[i].y);
+    return emoface::render::testing::quad_mesh(corners, uvs);
 }
 
 std::vector<std::uint8_t> quadrant_normal_map() {

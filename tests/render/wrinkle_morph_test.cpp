@@ -15,6 +15,7 @@
 #include "emoface/render/platform.h"
 #include "emoface/render/wrinkle_morph.h"
 #include "emoface/render/wrinkle_texture.h"
+#include "support/parity.h"
 
 namespace {
 
@@ -144,35 +145,30 @@ TEST_F(WrinkleMorphTest, CpuUploadHoldsExactlyTheHostMorphFloat) {
     EXPECT_EQ(tex, host);
 }
 
-TEST_F(WrinkleMorphTest, InteropMatchesTheCpuMorph8Bit) {
+// The CUDA morph written straight into the GL texture against the CPU morph
+// on the host, for one pixel format; skips where CUDA cannot share the
+// context's textures.
+template <class T>
+void expect_interop_matches_the_cpu_morph(Platform& platform, morph::PixelFormat format, double tolerance) {
     if (!morph::cuda_available() || !cuda_interop_available())
         GTEST_SKIP() << "no CUDA device: " << morph::cuda_device_description();
-    if (platform_->is_software())
-        GTEST_SKIP() << "the GL context is not on the GPU (" << platform_->description()
+    if (platform.is_software())
+        GTEST_SKIP() << "the GL context is not on the GPU (" << platform.description()
                      << "): CUDA cannot share its textures";
-    std::vector<std::uint8_t> tex, host;
+    std::vector<T> tex, host;
     bool interop = false;
-    morph_both_ways(*platform_, morph::PixelFormat::Rgba8, morph::Backend::Cuda, tex, host,
-                    interop);
+    morph_both_ways(platform, format, morph::Backend::Cuda, tex, host, interop);
     EXPECT_TRUE(interop);
-    int worst = 0;
-    for (std::size_t i = 0; i < tex.size(); ++i) worst = std::max(worst, std::abs(tex[i] - host[i]));
-    EXPECT_LE(worst, 1) << "CPU and GPU morphs agree within one 8-bit step";
+    EXPECT_LE(emoface::testing::max_abs_diff(tex, host), tolerance);
+}
+
+TEST_F(WrinkleMorphTest, InteropMatchesTheCpuMorph8Bit) {
+    // CPU and GPU morphs agree within one 8-bit step.
+    expect_interop_matches_the_cpu_morph<std::uint8_t>(*platform_, morph::PixelFormat::Rgba8, 1.0);
 }
 
 TEST_F(WrinkleMorphTest, InteropMatchesTheCpuMorphFloat) {
-    if (!morph::cuda_available() || !cuda_interop_available())
-        GTEST_SKIP() << "no CUDA device: " << morph::cuda_device_description();
-    if (platform_->is_software())
-        GTEST_SKIP() << "the GL context is not on the GPU (" << platform_->description() << ")";
-    std::vector<float> tex, host;
-    bool interop = false;
-    morph_both_ways(*platform_, morph::PixelFormat::RgbaF32, morph::Backend::Cuda, tex, host,
-                    interop);
-    EXPECT_TRUE(interop);
-    float worst = 0;
-    for (std::size_t i = 0; i < tex.size(); ++i) worst = std::max(worst, std::fabs(tex[i] - host[i]));
-    EXPECT_LE(worst, 1e-4f);
+    expect_interop_matches_the_cpu_morph<float>(*platform_, morph::PixelFormat::RgbaF32, 1e-4);
 }
 
 TEST_F(WrinkleMorphTest, MismatchedTextureIsAnError) {

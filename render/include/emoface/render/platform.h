@@ -80,6 +80,9 @@ protected:
     void init_gl(int width, int height, int samples, const std::string& platform_name);
     void resize_targets(int width, int height);
     void destroy_gl();
+    // For destructors, before the context itself goes: deletes the
+    // framebuffers in this platform's context, then leaves no context current.
+    void close_gl();
 
 private:
     int width_ = 0, height_ = 0, samples_ = 1;
@@ -120,9 +123,5 @@ private:
     void* display_ = nullptr;  // EGLDisplay
     void* context_ = nullptr;  // EGLContext
 };
-
-// Window when asked for and a display exists, else headless.
-enum class PlatformKind { Headless, Window, Auto };
-std::unique_ptr<Platform> open_platform(PlatformKind kind, const PlatformOptions& options);
 
 }  // namespace emoface::render

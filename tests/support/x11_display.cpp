@@ -1,4 +1,4 @@
-#include "viewer_x11.h"
+#include "support/x11_display.h"
 
 #include <fcntl.h>
 #include <poll.h>
@@ -10,12 +10,13 @@
 #include <X11/Xlib.h>
 #include <X11/Xutil.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
 #include <thread>
 
-namespace emoface::apps::testing {
+namespace emoface::testing {
 
 namespace {
 
@@ -159,9 +160,14 @@ bool grab_window(const std::string& display, const std::string& title_prefix,
         if (std::chrono::steady_clock::now() > deadline) return false;
         std::this_thread::sleep_for(std::chrono::milliseconds(100));
     }
+    return grab_window(c.display, w, shot);
+}
+
+bool grab_window(Display* connection, unsigned long window, WindowShot& shot) {
+    XSync(connection, False);
     XWindowAttributes a;
-    if (!XGetWindowAttributes(c.display, w, &a)) return false;
-    XImage* image = XGetImage(c.display, w, 0, 0, unsigned(a.width), unsigned(a.height), AllPlanes, ZPixmap);
+    if (!XGetWindowAttributes(connection, window, &a)) return false;
+    XImage* image = XGetImage(connection, window, 0, 0, unsigned(a.width), unsigned(a.height), AllPlanes, ZPixmap);
     if (!image) return false;
     shot.width = a.width;
     shot.height = a.height;
@@ -177,6 +183,15 @@ bool grab_window(const std::string& display, const std::string& title_prefix,
         }
     XDestroyImage(image);
     return true;
+}
+
+render::ImageRGBA8 WindowShot::image() const {
+    render::ImageRGBA8 out(width, height);
+    for (std::size_t i = 0; i < std::size_t(width) * std::size_t(height); ++i) {
+        std::copy_n(&rgb[3 * i], 3, &out.pixels[4 * i]);
+        out.pixels[4 * i + 3] = 255;
+    }
+    return out;
 }
 
 namespace {
@@ -257,4 +272,4 @@ bool request_close(const std::string& display, const std::string& title_prefix) 
     return true;
 }
 
-}  // namespace emoface::apps::testing
+}  // namespace emoface::testing

@@ -1,67 +1,31 @@
 // `emoface info` end to end: the built binary on the bundled sample, bad
 // files, several files at once and the real files of other systems.
-#include <sys/wait.h>
-#include <unistd.h>
-
-#include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "support/run_emoface.h"
+#include "support/scratch_dir.h"
+
 namespace {
 
 namespace fs = std::filesystem;
-
-struct CommandResult {
-    int rc;
-    std::string out, err;
-};
-
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
+using emoface::testing::CommandResult;
+using emoface::testing::run_emoface;
 
 class InfoCli : public ::testing::Test {
 protected:
-    void SetUp() override {
-        dir_ = fs::temp_directory_path() / ("emoface_info_cli_" + std::to_string(::getpid()));
-        fs::create_directories(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
-
-    CommandResult run(const std::string& args) {
-        const fs::path out = dir_ / "stdout", err = dir_ / "stderr";
-        // Under ASan the binary keeps its error checks, but not LeakSanitizer:
-        // it links GL, OpenImageIO and OpenCV, whose one-time allocations may
-        // be reported at exit. fap_tests checks the reader for leaks.
-        const std::string command = std::string("ASAN_OPTIONS=\"${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0\" '") +
-                                    EMOFACE_BINARY + "' " + args + " >'" + out.string() + "' 2>'" +
-                                    err.string() + "'";
-        const int status = std::system(command.c_str());
-        return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
-    }
-
-    std::string write(const std::string& name, const std::string& text) {
-        const fs::path p = dir_ / name;
-        std::ofstream(p, std::ios::binary) << text;
-        return p.string();
-    }
-
-    fs::path dir_;
+    emoface::testing::ScratchDir scratch_;
 };
 
 const std::string kTour = std::string(EMOFACE_DATA_DIR) + "/fap/tour.fap";
 
 TEST_F(InfoCli, BundledTour) {
-    const CommandResult r = run("info '" + kTour + "'");
-    EXPECT_EQ(r.rc, 0) << r.err;
+    const CommandResult r = run_emoface({"info", kTour});
+    EXPECT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(r.err, "");
     EXPECT_NE(r.out.find("  version   2.1\n"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("  name      emoface tour\n"), std::string::npos);
@@ -74,8 +38,8 @@ TEST_F(InfoCli, BundledTour) {
 }
 
 TEST_F(InfoCli, Json) {
-    const CommandResult r = run("info --json '" + kTour + "'");
-    ASSERT_EQ(r.rc, 0) << r.err;
+    const CommandResult r = run_emoface({"info", "--json", kTour});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
     const nlohmann::json j = nlohmann::json::parse(r.out);
     ASSERT_TRUE(j.is_array());
     ASSERT_EQ(j.size(), 1u);
@@ -92,28 +56,28 @@ TEST_F(InfoCli, Json) {
 }
 
 TEST_F(InfoCli, BadFileIsOneLineAndExitTwo) {
-    const std::string bad = write("bad.fap", "2.1 anim 25 1\n1 0 0\n");
-    const CommandResult r = run("info '" + bad + "'");
-    EXPECT_EQ(r.rc, 2);
+    const std::string bad = scratch_.write("bad.fap", "2.1 anim 25 1\n1 0 0\n");
+    const CommandResult r = run_emoface({"info", bad});
+    EXPECT_EQ(r.exit_code, 2);
     EXPECT_EQ(r.out, "");
     EXPECT_EQ(r.err, "emoface: fap: " + bad +
                          ":2: frame 1: expected a mask of 68 tokens (69 from Greta's Java writer), found 3\n");
-    const CommandResult missing = run("info '" + (dir_ / "none.fap").string() + "'");
-    EXPECT_EQ(missing.rc, 2);
-    EXPECT_EQ(missing.err, "emoface: fap: " + (dir_ / "none.fap").string() +
+    const CommandResult missing = run_emoface({"info", scratch_.path("none.fap")});
+    EXPECT_EQ(missing.exit_code, 2);
+    EXPECT_EQ(missing.err, "emoface: fap: " + scratch_.path("none.fap") +
                                ": expected a readable FAP file, found No such file or directory\n");
 }
 
 TEST_F(InfoCli, SeveralFilesReportEveryGoodOneAndStillFail) {
-    const std::string bad1 = write("bad1.fap", "junk\n");
-    const std::string bad2 = write("bad2.fap", "");
-    const CommandResult r = run("info '" + bad1 + "' '" + kTour + "' '" + bad2 + "'");
-    EXPECT_EQ(r.rc, 2);
+    const std::string bad1 = scratch_.write("bad1.fap", "junk\n");
+    const std::string bad2 = scratch_.write("bad2.fap", "");
+    const CommandResult r = run_emoface({"info", bad1, kTour, bad2});
+    EXPECT_EQ(r.exit_code, 2);
     EXPECT_NE(r.out.find("  frames    50 (numbered 0..49)\n"), std::string::npos);
     EXPECT_EQ(r.err, "emoface: fap: " + bad1 + ":1: expected a header `version name fps count`, found 'junk'\n" +
                          "emoface: fap: " + bad2 + ":1: expected a header line `version name fps count`, found end of file\n");
-    const CommandResult j = run("info --json '" + bad1 + "' '" + kTour + "'");
-    EXPECT_EQ(j.rc, 2);
+    const CommandResult j = run_emoface({"info", "--json", bad1, kTour});
+    EXPECT_EQ(j.exit_code, 2);
     const nlohmann::json parsed = nlohmann::json::parse(j.out);
     ASSERT_EQ(parsed.size(), 2u);
     EXPECT_TRUE(parsed[0].contains("error"));
@@ -124,10 +88,10 @@ TEST_F(InfoCli, SeveralFilesReportEveryGoodOneAndStillFail) {
 TEST_F(InfoCli, RealFiles) {
     const fs::path real = fs::path(EMOFACE_REALDATA_DIR) / "fap";
     if (!fs::is_directory(real)) GTEST_SKIP() << "no real FAP files at " << real;
-    std::string args = "info --json";
-    for (const auto& e : fs::directory_iterator(real)) args += " '" + e.path().string() + "'";
-    const CommandResult r = run(args);
-    ASSERT_EQ(r.rc, 0) << r.err;
+    std::vector<std::string> args{"info", "--json"};
+    for (const auto& e : fs::directory_iterator(real)) args.push_back(e.path().string());
+    const CommandResult r = run_emoface(args);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
     const nlohmann::json j = nlohmann::json::parse(r.out);
     int xface_emotions = 0;
     for (const auto& f : j) {

@@ -1,16 +1,20 @@
 #pragma once
-// What the viewer test needs from X: a private Xvfb server, finding the
-// viewer's window by its title, reading the window's pixels as the server
-// holds them (what a person sees), and asking it to close as a window
-// manager would. In its own file because Xlib's macros (None, Bool, Status)
-// break C++ headers.
+// What the windowed tests need from X: a private Xvfb server, finding a
+// window by its title, reading a window's pixels as the server holds them
+// (what a person sees), mouse input, and asking a window to close as a
+// window manager would. Xlib stays in the .cpp: its macros (None, Bool,
+// Status) break C++ headers.
 #include <sys/types.h>
 
 #include <cstdint>
 #include <string>
 #include <vector>
 
-namespace emoface::apps::testing {
+#include "emoface/render/image.h"
+
+struct _XDisplay;  // Xlib's Display
+
+namespace emoface::testing {
 
 // An Xvfb server on a display number it picks itself (-displayfd), so tests
 // running side by side never collide. Stopped by the destructor.
@@ -34,7 +38,15 @@ struct WindowShot {
     int width = 0, height = 0;
     std::vector<std::uint8_t> rgb;  // top row first
     std::string title;
+
+    // The pixels as an opaque image (for render::diff_images).
+    render::ImageRGBA8 image() const;
 };
+
+// The one grab: reads window `window` (an X window id) through an open
+// connection, after XSync so that what was drawn has arrived. False when the
+// pixels cannot be read. (GLFW: glfwGetX11Display(), glfwGetX11Window().)
+bool grab_window(_XDisplay* connection, unsigned long window, WindowShot& shot);
 
 // Waits up to `seconds` for a top-level window whose title starts with
 // `title_prefix` and does not contain `not_containing` (when given), then
@@ -59,4 +71,4 @@ bool scroll(const std::string& display, const std::string& title_prefix, int x, 
 // close button of a window manager). False when there is no such window.
 bool request_close(const std::string& display, const std::string& title_prefix);
 
-}  // namespace emoface::apps::testing
+}  // namespace emoface::testing
