@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <random>
 
 #include "emoface/common/error.h"
 #include "emoface/fap/feature_points.h"
@@ -113,6 +114,16 @@ private:
     void build_skin(Face& face);
     void build_eyeball(Face& face, int side);
     void build_mouth_interior(Face& face);
+    void build_lashes(Face& face, int side, bool upper);
+    // An eyelid margin's vertices from the inner to the outer corner.
+    std::vector<int> margin(int side, bool upper) const {
+        std::vector<int> m;
+        for (int i = eye_in_col_; i <= eye_out_col_; ++i) {
+            const int c = side == 0 ? i : 2 * centre_col_ - i;
+            m.push_back(!upper && eye_lower_copy_[c] >= 0 ? eye_lower_copy_[c] : grid(c, eye_row_));
+        }
+        return m;
+    }
     void place_feature_points(Face& face);
 
     int grid(int i, int j) const { return j * (ncols_ + 1) + i; }
@@ -471,14 +482,83 @@ void Generator::build_eyeball(Face& face, int side) {
         }
     for (int s = 0; s < segs; ++s) add_oriented(face, back, ring(nr - 1, s + 1), ring(nr - 1, s), out(ring(nr - 1, s)));
 
-    // Eyelid margins from the inner to the outer corner.
-    auto col = [&](int i) { return side == 0 ? i : 2 * centre_col_ - i; };
-    for (int i = eye_in_col_; i <= eye_out_col_; ++i) {
-        const int ci = col(i);
-        eb.upper_margin.push_back(grid(ci, eye_row_));
-        eb.lower_margin.push_back(eye_lower_copy_[ci] >= 0 ? eye_lower_copy_[ci] : grid(ci, eye_row_));
-    }
+    eb.upper_margin = margin(side, true);
+    eb.lower_margin = margin(side, false);
     face.eyeballs.push_back(std::move(eb));
+}
+
+// Eyelashes: thin ribbons, each grown from the lid margin in three segments
+// that turn away from the eye (up for the upper lid, down for the lower)
+// more and more towards the tip, with some spread in length and direction
+// so they clump as lashes do. A lash's first vertex is welded to the margin
+// vertex it grows from: the rig carries the lash with that vertex, turning it
+// as the lid turns about the eye. Their UVs fall in the eye tile's corner,
+// painted the lashes' colour.
+void Generator::build_lashes(Face& face, int side, bool upper) {
+    const FaceParams::LashRow& row = upper ? p_.upper_lashes : p_.lower_lashes;
+    const std::vector<int> margin = this->margin(side, upper);
+    if (row.count == 0 || margin.size() < 3) return;
+    auto point = [&](int v) {
+        const auto q = face.mesh.point(TriMesh::VertexHandle(v));
+        return V3{q[0], q[1], q[2]};
+    };
+    std::vector<double> arc(margin.size(), 0.0);
+    for (std::size_t i = 1; i < margin.size(); ++i) arc[i] = arc[i - 1] + length(point(margin[i]) - point(margin[i - 1]));
+    const V3 centre{p_.eye_centre[0] * (side == 0 ? 1.0 : -1.0), p_.eye_centre[1], p_.eye_centre[2]};
+    const double outward = side == 0 ? 1.0 : -1.0;  // +x towards this eye's outer corner
+    std::mt19937 random(static_cast<unsigned>(1 + 2 * side + (upper ? 0 : 1)));
+    auto uniform = [&] { return static_cast<double>(random()) / 4294967296.0; };
+    constexpr int kSections = 4;
+    const double u0 = detail::tile_u0(detail::Tile::Eye);
+    for (int k = 0; k < row.count; ++k) {
+        // Where along the margin (0 inner corner, 1 outer), clear of the corners.
+        const double s = 0.05 + 0.9 * (k + 0.5 + 0.8 * (uniform() - 0.5)) / row.count;
+        const double at = s * arc.back();
+        std::size_t i = 1;
+        while (i + 1 < arc.size() && arc[i] < at) ++i;
+        const double t = (at - arc[i - 1]) / std::max(arc[i] - arc[i - 1], 1e-9);
+        const V3 a = point(margin[i - 1]), b = point(margin[i]);
+        const V3 root = a + (b - a) * t;
+        const int anchor = margin[t < 0.5 ? i - 1 : i];
+        // The frame at the root: radial out of the eye, along the margin
+        // towards the outer corner, and away from the opening.
+        const V3 radial = detail::normalised(root - centre);
+        V3 along = detail::normalised(b - a);
+        if (along.x * outward < 0) along = along * -1.0;
+        V3 away = detail::normalised(V3{along.y * radial.z - along.z * radial.y, along.z * radial.x - along.x * radial.z,
+                                        along.x * radial.y - along.y * radial.x});
+        if ((away.y > 0) != upper) away = away * -1.0;
+        // Longest mid-lid, shortest at the inner end (FIDELITY.md).
+        const double len = row.length * (0.45 + 0.55 * std::pow(std::sin(kPi * s), 0.6)) * (0.75 + 0.25 * s) *
+                           (0.85 + 0.3 * uniform());
+        const double lift = (row.lift_deg + 12.0 * (uniform() - 0.5)) * kDeg;
+        const double curl = row.curl_deg * (0.8 + 0.4 * uniform()) * kDeg;
+        const double splay = 0.25 * (uniform() - 0.5) + 0.35 * (s - 0.5);  // outer lashes lean outwards
+        V3 p = root + radial * 0.3;  // from the lid's front edge
+        const int first = face.vertex_count();
+        for (int c = 0; c < kSections; ++c) {
+            const double f = static_cast<double>(c) / (kSections - 1);
+            const double angle = lift + curl * f * f;
+            const V3 dir = detail::normalised(radial * std::cos(angle) + away * std::sin(angle) + along * splay);
+            const double half = 0.5 * row.width * (1.0 - 0.8 * f);
+            const V3 side_dir = detail::normalised(along - dir * detail::dot(along, dir));
+            const double u = u0 + detail::kTile * (0.02 + 0.06 * f);
+            add_vertex(face, p - side_dir * half, u, detail::kTile * 0.02, VertexPart::Skin);
+            add_vertex(face, p + side_dir * half, u, detail::kTile * 0.08, VertexPart::Skin);
+            if (c + 1 < kSections) {
+                const double g = (c + 0.5) / (kSections - 1);
+                const double mid = lift + curl * g * g;
+                p = p + detail::normalised(radial * std::cos(mid) + away * std::sin(mid) + along * splay) *
+                            (len / (kSections - 1));
+            }
+        }
+        for (int c = 0; c + 1 < kSections; ++c) {
+            const int q = first + 2 * c;
+            add_triangle(face, q, q + 1, q + 3);
+            add_triangle(face, q, q + 3, q + 2);
+        }
+        face.welded.push_back({anchor, first});
+    }
 }
 
 void Generator::build_mouth_interior(Face& face) {
@@ -799,6 +879,11 @@ Face Generator::build(int texture_size) {
     make_rows();
     compute_warps();
     build_skin(face);
+    // Lashes are skin (the renderer splits the mesh into runs of one part).
+    for (int side = 0; side < 2; ++side) {
+        build_lashes(face, side, true);
+        build_lashes(face, side, false);
+    }
     const int skin_count = face.vertex_count();
     build_eyeball(face, 0);
     build_eyeball(face, 1);

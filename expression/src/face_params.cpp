@@ -103,6 +103,18 @@ FaceParams read_face_params(const std::string& params_dir) {
             p.lid_blend_inner = r.number("lid_blend_inner");
             p.lid_blend_outer = r.number("lid_blend_outer");
             p.lid_warp_reach = r.number("lid_warp_reach");
+            p.sclera_corner_tint = r.number_in("sclera_corner_tint", 0.0, 1.0);
+            p.sclera_vessels = r.number_in("sclera_vessels", 0.0, 1.0);
+            p.lid_shadow = r.number_in("lid_shadow", 0.0, 0.8);
+            for (auto [key, row] : {std::pair{"upper_lashes", &p.upper_lashes}, std::pair{"lower_lashes", &p.lower_lashes}}) {
+                JsonReader l = r.object(key);
+                row->count = l.integer_in("count", 0, 400);
+                row->length = l.number_in("length", 0.5, 20.0);
+                row->width = l.number_in("width", 0.01, 1.0);
+                row->lift_deg = l.number_in("lift_deg", -90.0, 90.0);
+                row->curl_deg = l.number_in("curl_deg", -90.0, 90.0);
+                l.finish();
+            }
             if (!(p.eye_radius > 0 && p.iris_radius > p.pupil_radius && p.pupil_radius > 0 &&
                   p.iris_radius < p.eye_radius))
                 r.fail("radius > iris_radius > pupil_radius > 0",
@@ -196,7 +208,9 @@ FaceParams read_face_params(const std::string& params_dir) {
             p.brows = colour(r, "brows");
             p.hair = colour(r, "hair");
             p.iris = colour(r, "iris");
+            p.iris_inner = colour(r, "iris_inner");
             p.sclera = colour(r, "sclera");
+            p.lashes = colour(r, "lashes");
             p.mouth = colour(r, "mouth");
             p.teeth = colour(r, "teeth");
             p.tongue = colour(r, "tongue");

@@ -84,6 +84,17 @@ struct FaceParams {
     double lid_clearance = 0.0, lid_thickness = 0.0;
     double lid_blend_inner = 0.0, lid_blend_outer = 0.0;
     double lid_warp_reach = 0.0;
+    // the eyeball's colour (eye_texture.cpp): 0..1 strengths
+    double sclera_corner_tint = 0.0, sclera_vessels = 0.0, lid_shadow = 0.0;
+    // eyelashes along each margin (default_face.cpp): how many, their length
+    // and root width (mm), the angle they leave the lid at, away from the
+    // eye's radial direction (degrees), and how much more they turn (curl)
+    // by their tips
+    struct LashRow {
+        int count = 0;
+        double length = 0.0, width = 0.0, lift_deg = 0.0, curl_deg = 0.0;
+    };
+    LashRow upper_lashes, lower_lashes;
 
     // mouth
     double mouth_y = 0.0, mouth_half_width = 0.0, mouth_corner_rise = 0.0;
@@ -122,7 +133,7 @@ struct FaceParams {
     std::map<std::string, std::vector<double>> feature_targets;
 
     // colours (sRGB 0..255)
-    Vec3 skin{}, lips{}, brows{}, hair{}, iris{}, sclera{}, mouth{}, teeth{}, tongue{};
+    Vec3 skin{}, lips{}, brows{}, hair{}, iris{}, iris_inner{}, sclera{}, lashes{}, mouth{}, teeth{}, tongue{};
     // brows (left): inner, peak, outer points and thickness at each
     std::array<Vec2, 3> brow_points{};
     Vec3 brow_thickness{};

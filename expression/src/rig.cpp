@@ -380,6 +380,28 @@ void FaceRig::build_eyes(const Face& face) {
             }
         eyes_.push_back(std::move(e));
     }
+    // Lashes: the component (along mesh edges) of a skin vertex welded to a
+    // margin vertex, if it is a small strand and not a stretch of skin split
+    // by a UV seam.
+    for (std::size_t e = 0; e < face.eyeballs.size(); ++e) {
+        const Eyeball& eb = face.eyeballs[e];
+        std::vector<int> margin(eb.upper_margin);
+        margin.insert(margin.end(), eb.lower_margin.begin(), eb.lower_margin.end());
+        auto on_margin = [&](int v) { return std::find(margin.begin(), margin.end(), v) != margin.end(); };
+        for (const auto& w : face.welded)
+            for (int k = 0; k < 2; ++k) {
+                const int anchor = w[k], root = w[1 - k];
+                if (!on_margin(anchor) || on_margin(root) || parts_[root] != VertexPart::Skin) continue;
+                constexpr std::size_t kMaxStrand = 64;
+                std::vector<int> strand{root};
+                for (std::size_t q = 0; q < strand.size() && strand.size() <= kMaxStrand; ++q)
+                    for (auto vv : face.mesh.vv_range(TriMesh::VertexHandle(strand[q])))
+                        if (std::find(strand.begin(), strand.end(), vv.idx()) == strand.end()) strand.push_back(vv.idx());
+                if (strand.size() > kMaxStrand) continue;
+                for (int v : strand) lash_vertices_.push_back({v, anchor, static_cast<int>(e)});
+            }
+    }
+
     // Skin in front of an eyeball keeps at least its neutral clearance (the
     // margins' at most), so a closing lid slides over the eye; what a lid FAP
     // carries also keeps its neutral distance from the eyeball's centre, so
@@ -487,6 +509,18 @@ void FaceRig::deform(const FapValues& faps, DeformedFace& out) const {
                 const double shell_z = e.centre[2] + std::sqrt(s2 - dx * dx - dy * dy);
                 p[2] = static_cast<float>(p[2] + lv.follow * (shell_z - p[2]));
             }
+        }
+        // Lashes ride on their margin vertex, turned by the angle it turned
+        // through about the eyeball's horizontal axis.
+        for (const LashVertex& l : lash_vertices_) {
+            const EyeState& e = eyes_[l.eye];
+            const auto a0 = neutral_[l.anchor], a = pos[l.anchor];
+            const double turn = std::atan2(a[1] - e.centre[1], a[2] - e.centre[2]) -
+                                std::atan2(a0[1] - e.centre[1], a0[2] - e.centre[2]);
+            const auto off = neutral_[l.vertex] - a0;
+            const double c = std::cos(turn), s = std::sin(turn);
+            pos[l.vertex] = a + TriMesh::Point(off[0], static_cast<float>(off[1] * c + off[2] * s),
+                                               static_cast<float>(off[2] * c - off[1] * s));
         }
     }
 

@@ -212,7 +212,7 @@ TEST_F(BadFaceParams, MessagesNameTheFileAndKey) {
          "expression: " + file + ": eyes.radiuss: expected a known key (centre, radius, iris_radius, pupil_radius, "
                                 "inner_corner, outer_corner, upper_lid_height, lower_lid_height, upper_lid_peak, "
                                 "lower_lid_peak, lid_clearance, lid_thickness, lid_blend_inner, lid_blend_outer, "
-                                "lid_warp_reach), found \"radiuss\""},
+                                "lid_warp_reach, sclera_corner_tint, sclera_vessels, lid_shadow, upper_lashes, lower_lashes), found \"radiuss\""},
         {replaced("\"iris_radius\": 5.9,", ""), "expression: " + file + ": eyes.iris_radius: expected a value, found no such key"},
         {replaced("\"centre_y\": -66,", "\"centre_y\": \"low\","),
          "expression: " + file + ": mouth.centre_y: expected a number, found \"low\""},

@@ -133,6 +133,14 @@ private:
     std::vector<int> lid_fps_;              // 3.1-3.4 where the face has eyelid margins
     std::vector<LidWeight> lid_weights_;
     std::vector<LidVertex> lid_vertices_;
+    // Eyelashes: a strand whose first vertex is welded to a lid margin
+    // vertex rides on that vertex, turning with it about the eyeball.
+    struct LashVertex {
+        int vertex;
+        int anchor;  // the margin vertex
+        int eye;
+    };
+    std::vector<LashVertex> lash_vertices_;
 
     // Head.
     std::array<double, 3> head_pivot_{};
