@@ -8,19 +8,16 @@
 #include "emoface/common/error.h"
 #include "emoface/fap/fap_io.h"
 #include "fap_test_util.h"
+#include "support/expect_error.h"
 
 namespace emoface::fap {
 namespace {
 
 using test::mask_line;
 
+// The message parse_fap throws for `text` ("(no error)" when it parses).
 std::string error_of(const std::string& text) {
-    try {
-        parse_fap(text, "t.fap");
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "(no error)";
+    return emoface::testing::thrown_message<InputError>([&] { parse_fap(text, "t.fap"); });
 }
 
 // Two frames: FAP 3 and 31 in both, FAP 2 (6 values) in the second.

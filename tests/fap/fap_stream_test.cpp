@@ -6,19 +6,12 @@
 
 #include "emoface/common/error.h"
 #include "emoface/fap/fap_stream.h"
+#include "support/expect_error.h"
 
 namespace emoface::fap {
 namespace {
 
-template <typename F>
-std::string error_of(F&& f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "(no error)";
-}
+using emoface::testing::expect_error;
 
 TEST(FapFrame, SetGetHasClear) {
     FapFrame f;
@@ -41,10 +34,10 @@ TEST(FapFrame, SetGetHasClear) {
 
 TEST(FapFrame, NumberErrors) {
     FapFrame f;
-    EXPECT_EQ(error_of([&] { f.has(0); }), "fap: FapFrame::has: expected a FAP number 1..68, found 0");
-    EXPECT_EQ(error_of([&] { f.get(69); }), "fap: FapFrame::get: expected a FAP number 1..68, found 69");
-    EXPECT_EQ(error_of([&] { f.set(2, 1); }), "fap: FapFrame::set: expected a FAP number 3..68, found 2");
-    EXPECT_EQ(error_of([&] { f.clear(-1); }), "fap: FapFrame::clear: expected a FAP number 1..68, found -1");
+    expect_error<Error>([&] { f.has(0); }, "fap: FapFrame::has: expected a FAP number 1..68, found 0");
+    expect_error<Error>([&] { f.get(69); }, "fap: FapFrame::get: expected a FAP number 1..68, found 69");
+    expect_error<Error>([&] { f.set(2, 1); }, "fap: FapFrame::set: expected a FAP number 3..68, found 2");
+    expect_error<Error>([&] { f.clear(-1); }, "fap: FapFrame::clear: expected a FAP number 1..68, found -1");
 }
 
 TEST(FapFrame, EqualityComparesTransmittedContentOnly) {
@@ -115,7 +108,7 @@ TEST(FapStream, ResolvedKeepsLastTransmittedValue) {
     const FapFrame r0 = s.resolved(0);
     EXPECT_FALSE(r0.has(31));
     EXPECT_EQ(r0.get(31), 0);
-    EXPECT_EQ(error_of([&] { s.resolved(3); }),
+    expect_error<Error>([&] { s.resolved(3); },
               "fap: FapStream::resolved: expected a frame index below 3, found 3");
 }
 
@@ -180,12 +173,12 @@ TEST(FapStream, SampleEdgeCases) {
     const FapFrame empty = FapStream{}.sample(1.0);
     EXPECT_TRUE(empty.mask.none());
     FapStream s = three_frames();
-    EXPECT_EQ(error_of([&] { s.sample(std::nan("")); }),
+    expect_error<Error>([&] { s.sample(std::nan("")); },
               "fap: FapStream::sample: expected a finite time in seconds, found nan");
-    EXPECT_EQ(error_of([&] { s.sample(std::numeric_limits<double>::infinity()); }),
+    expect_error<Error>([&] { s.sample(std::numeric_limits<double>::infinity()); },
               "fap: FapStream::sample: expected a finite time in seconds, found inf");
     s.fps = 0;
-    EXPECT_EQ(error_of([&] { s.sample(0.0); }),
+    expect_error<Error>([&] { s.sample(0.0); },
               "fap: FapStream::sample: expected a frame rate > 0, found 0");
     // Huge times and frame rates never index past the frames.
     s.fps = 1e300;
