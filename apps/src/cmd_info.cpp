@@ -2,7 +2,6 @@
 #include <algorithm>
 #include <cstdio>
 #include <map>
-#include <set>
 #include <string>
 #include <vector>
 
@@ -24,12 +23,28 @@ struct FapRange {
     std::size_t frames;  // frames that transmit it
 };
 
+// One FAP 1 viseme or FAP 2 expression code over the file: the frames that
+// select it (by index from 0, as play --frames and inspect --frame count)
+// and, for an expression, the range of its intensity there (0..63).
+struct CodeUse {
+    std::size_t frames = 0;
+    std::size_t first = 0, last = 0;
+    int min = 0, max = 0;
+    void add(std::size_t frame, int value) {
+        if (frames == 0) first = frame, min = max = value;
+        last = frame;
+        min = std::min(min, value);
+        max = std::max(max, value);
+        ++frames;
+    }
+};
+
 struct Summary {
-    std::vector<FapRange> moving;  // transmitted with some non-zero value
+    std::vector<FapRange> moving;  // low-level FAPs transmitted with some non-zero value
     std::size_t viseme_frames = 0;
-    std::set<int> viseme_codes;
+    std::map<int, CodeUse> visemes;      // code 1..14 -> use (0 is no viseme)
     std::size_t expression_frames = 0;
-    std::map<int, int> expression_peak;  // code -> highest intensity seen
+    std::map<int, CodeUse> expressions;  // code 1..6 -> use (neutral, 0, is no expression)
 };
 
 Summary summarize(const FapStream& s) {
@@ -47,23 +62,21 @@ Summary summarize(const FapStream& s) {
         }
         if (nonzero) out.moving.push_back(r);
     }
-    for (const FapFrame& f : s.frames) {
+    for (std::size_t k = 0; k < s.frames.size(); ++k) {
+        const FapFrame& f = s.frames[k];
         if (f.has(1)) {
             ++out.viseme_frames;
-            out.viseme_codes.insert(f.viseme.select1);
-            if (f.viseme.blend != 0 || f.viseme.select2 != 0) out.viseme_codes.insert(f.viseme.select2);
+            // Only where each viseme shows: how the blend weighs the two
+            // depends on the file's writer (a one-value FAP 1 has no blend).
+            const Viseme& v = f.viseme;
+            if (v.select1 != 0) out.visemes[v.select1].add(k, 0);
+            if (v.select2 != 0 && v.select2 != v.select1) out.visemes[v.select2].add(k, 0);
         }
         if (f.has(2)) {
             ++out.expression_frames;
             const Expression& e = f.expression;
-            // Neutral (code 0) is the absence of an expression, not one to list.
-            auto peak = [&](int code, int intensity) {
-                if (code == 0) return;
-                auto [it, inserted] = out.expression_peak.emplace(code, intensity);
-                if (!inserted) it->second = std::max(it->second, intensity);
-            };
-            peak(e.select1, e.intensity1);
-            if (e.select2 != 0 || e.intensity2 != 0) peak(e.select2, e.intensity2);
+            if (e.select1 != 0) out.expressions[e.select1].add(k, e.intensity1);
+            if (e.select2 != 0 && e.select2 != e.select1) out.expressions[e.select2].add(k, e.intensity2);
         }
     }
     return out;
@@ -87,29 +100,44 @@ void print_text(const std::string& path, const FapStream& s) {
         fmt::print("  frames    {} (numbered {}..{})\n", s.frames.size(), s.frames.front().number,
                    s.frames.back().number);
     fmt::print("  duration  {:.3f} s\n", s.duration());
-    if (sum.moving.empty()) {
-        fmt::print("  moving    none\n");
-    } else {
-        fmt::print("  moving    {} FAPs\n", sum.moving.size());
-        for (const FapRange& r : sum.moving)
-            fmt::print("    {:>2} {:<22} {} .. {}\n", r.fap, fap_info(r.fap).name, r.min, r.max);
-    }
+    // What moves the face, through whichever channel: low-level FAPs, FAP 1
+    // visemes, FAP 2 expressions (a file may drive it by FAP 2 alone).
+    std::vector<std::string> movers;
+    if (!sum.moving.empty()) movers.push_back(fmt::format("{} low-level FAPs", sum.moving.size()));
+    if (!sum.visemes.empty()) movers.push_back(fmt::format("{} visemes (FAP 1)", sum.visemes.size()));
+    const auto expressions = std::count_if(sum.expressions.begin(), sum.expressions.end(),
+                                           [](const auto& e) { return e.second.max > 0; });
+    if (expressions > 0) movers.push_back(fmt::format("{} expressions (FAP 2)", expressions));
+    if (movers.empty())
+        fmt::print("  moving    nothing: every frame is the neutral face\n");
+    else
+        fmt::print("  moving    {}{}\n", fmt::join(movers, ", "),
+                   sum.moving.empty() ? "; no low-level FAP" : "");
+    for (const FapRange& r : sum.moving)
+        fmt::print("    {:>2} {:<22} {} .. {}\n", r.fap, fap_info(r.fap).name, r.min, r.max);
+    auto span = [](const CodeUse& u) {
+        return fmt::format("{} {} in {}..{}", u.frames, frames_word(u.frames), u.first, u.last);
+    };
     if (sum.viseme_frames == 0) {
         fmt::print("  FAP 1     not used\n");
     } else {
-        std::vector<std::string> codes;
-        for (int c : sum.viseme_codes) codes.push_back(fmt::format("{} ({})", c, code_label(viseme_name(c), c)));
-        fmt::print("  FAP 1     {} {}, visemes {}\n", sum.viseme_frames, frames_word(sum.viseme_frames),
-                   fmt::join(codes, ", "));
+        fmt::print("  FAP 1     {} {}, {}\n", sum.viseme_frames, frames_word(sum.viseme_frames),
+                   sum.visemes.empty() ? std::string("no viseme (code 0 only)")
+                                       : fmt::format("{} visemes (frames counted from 0):", sum.visemes.size()));
+        for (const auto& [code, use] : sum.visemes)
+            fmt::print("    {:>2} {:<9} {}\n", code, code_label(viseme_name(code), code), span(use));
     }
     if (sum.expression_frames == 0) {
         fmt::print("  FAP 2     not used\n");
     } else {
-        std::vector<std::string> peaks;
-        for (auto [code, intensity] : sum.expression_peak)
-            peaks.push_back(fmt::format("{} up to {}", code_label(expression_name(code), code), intensity));
         fmt::print("  FAP 2     {} {}, {}\n", sum.expression_frames, frames_word(sum.expression_frames),
-                   peaks.empty() ? std::string("neutral only") : fmt::format("{}", fmt::join(peaks, ", ")));
+                   sum.expressions.empty()
+                       ? std::string("neutral only")
+                       : fmt::format("{} expressions (intensity 0..63; frames counted from 0):",
+                                     sum.expressions.size()));
+        for (const auto& [code, use] : sum.expressions)
+            fmt::print("    {:<9} intensity {:>2}..{:<2}  {}\n", code_label(expression_name(code), code), use.min,
+                       use.max, span(use));
     }
     if (s.warnings.empty()) {
         fmt::print("  warnings  none\n");
@@ -158,10 +186,26 @@ nlohmann::json to_json(const std::string& path, const FapStream& s) {
                                     {"min", r.min},
                                     {"max", r.max},
                                     {"frames", r.frames}});
-    j["viseme"] = {{"frames", sum.viseme_frames}, {"codes", sum.viseme_codes}};
+    std::vector<int> viseme_codes;
+    nlohmann::json visemes = nlohmann::json::array();
+    for (const auto& [code, use] : sum.visemes) {
+        viseme_codes.push_back(code);
+        visemes.push_back({{"code", code},
+                           {"name", viseme_name(code)},
+                           {"frames", use.frames},
+                           {"first_frame", use.first},
+                           {"last_frame", use.last}});
+    }
+    j["viseme"] = {{"frames", sum.viseme_frames}, {"codes", viseme_codes}, {"visemes", visemes}};
     nlohmann::json expressions = nlohmann::json::array();
-    for (auto [code, intensity] : sum.expression_peak)
-        expressions.push_back({{"code", code}, {"name", expression_name(code)}, {"max_intensity", intensity}});
+    for (const auto& [code, use] : sum.expressions)
+        expressions.push_back({{"code", code},
+                               {"name", expression_name(code)},
+                               {"min_intensity", use.min},
+                               {"max_intensity", use.max},
+                               {"frames", use.frames},
+                               {"first_frame", use.first},
+                               {"last_frame", use.last}});
     j["expression"] = {{"frames", sum.expression_frames}, {"expressions", expressions}};
     j["warnings"] = s.warnings;
     return j;

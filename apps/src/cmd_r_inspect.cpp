@@ -64,8 +64,13 @@ cv::Mat inspect_picture(Session& session, const expression::FaceState& state, co
     return out;
 }
 
-std::string state_title(const std::string& source, const expression::FaceState& s) {
-    return fmt::format("{}   mix: {} ({})", source, mix_label(s.mix), expression::mix_source_name(s.mix_source));
+// "tour.fap frame 12/49   mix 0.70 anger + 0.30 fear [expression (FAP 2)]"
+// for a frame (where the mix came from in brackets: the source names carry
+// parentheses of their own); "mix 1.00 sadness" for a --mix.
+std::string state_title(const std::optional<std::string>& frame, const expression::FaceState& s) {
+    const std::string mix = "mix " + mix_label(s.mix);
+    if (!frame) return mix;
+    return fmt::format("{}   {} [{}]", *frame, mix, expression::mix_source_name(s.mix_source));
 }
 
 void run_inspect(const InspectArgs& a) {
@@ -85,10 +90,7 @@ void run_inspect(const InspectArgs& a) {
     const SessionOptions so = a.session.resolve("inspect", width, height);
     const bool window = a.out.empty();
     if (window) {
-        const char* display = std::getenv("DISPLAY");
-        if (!display || !*display)
-            fail<EnvironmentError>("inspect: no display for the window (DISPLAY is not set): give --out "
-                                   "overlay.png to write the picture");
+        require_display("inspect", "the window", "give --out overlay.png to write the picture instead");
     } else {
         check_output_folder(a.out, "inspect");
     }
@@ -103,8 +105,10 @@ void run_inspect(const InspectArgs& a) {
         return stream ? session.face_state(stream->frames[std::size_t(frame)]) : session.face_state(mix);
     };
     auto title_now = [&](const expression::FaceState& s) {
-        return stream ? state_title(fmt::format("{} frame {}/{}", std::filesystem::path(a.fap).filename().string(), frame, stream->frames.size() - 1), s)
-                      : state_title("mix", s);
+        if (!stream) return state_title(std::nullopt, s);
+        return state_title(fmt::format("{} frame {}/{}", std::filesystem::path(a.fap).filename().string(), frame,
+                                       stream->frames.size() - 1),
+                           s);
     };
 
     if (!window) {
@@ -116,6 +120,8 @@ void run_inspect(const InspectArgs& a) {
                    std::count_if(session.feature_points().begin(), session.feature_points().end(),
                                  [](const auto& p) { return bool(p); }),
                    session.lines().size());
+        fmt::print("inspect: {}\n{}", session.description(),
+                   format_times(session.load_times(), session.frame_totals()));
         return;
     }
 
@@ -152,6 +158,8 @@ void run_inspect(const InspectArgs& a) {
         }
     }
     cv::destroyWindow(name);
+    fmt::print("inspect: {}\n{}", session.description(),
+               format_times(session.load_times(), session.frame_totals()));
 }
 
 void add_inspect_command(CLI::App& root) {

@@ -16,7 +16,9 @@ int main(int argc, char** argv) {
     using namespace emoface::apps;
     CLI::App app{
         "emoface: plays MPEG-4 facial animation (FAP files) and emotion mixtures\n"
-        "on a face mesh, with wrinkle maps morphed every frame and bump-mapped."};
+        "on a face mesh, with wrinkle maps morphed every frame and bump-mapped.",
+        // Named, so usage lines say `emoface play ...`, not argv[0]'s full path.
+        "emoface"};
     app.require_subcommand(1);
     app.set_version_flag("--version", "emoface 0.1.0");
     app.add_flag_callback(

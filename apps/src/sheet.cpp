@@ -8,6 +8,7 @@
 #include "emoface/common/error.h"
 #include "emoface/fap/feature_points.h"
 #include "emoface/render/image_io.h"
+#include "label_placement.h"
 
 namespace emoface::apps {
 
@@ -122,11 +123,9 @@ cv::Scalar group_colour(int group) {
 
 }  // namespace
 
-void draw_feature_overlay(cv::Mat& image, const std::array<std::optional<glm::vec2>, 84>& points,
+void draw_feature_overlay(cv::Mat& image, const std::array<std::optional<glm::vec2>, expression::kFeatureCount>& points,
                           const std::vector<expression::FeatureLine>& lines, bool labels) {
     const auto& table = fap::feature_points();
-    const double scale = std::clamp(image.rows / 1600.0, 0.28, 0.45);
-    auto px = [](const glm::vec2& p) { return cv::Point2f(p.x, p.y); };
     constexpr int kShift = 4;  // sub-pixel line positions
     auto fixed = [](const glm::vec2& p) { return cv::Point(int(std::lround(p.x * 16)), int(std::lround(p.y * 16))); };
     for (const auto& l : lines) {
@@ -137,19 +136,67 @@ void draw_feature_overlay(cv::Mat& image, const std::array<std::optional<glm::ve
     }
     for (std::size_t i = 0; i < points.size(); ++i) {
         if (!points[i]) continue;
-        const cv::Scalar colour = group_colour(table[i].group);
         cv::circle(image, fixed(*points[i]), 3 << kShift, cv::Scalar(0, 0, 0), -1, cv::LINE_AA, kShift);
-        cv::circle(image, fixed(*points[i]), 2 << kShift, colour, -1, cv::LINE_AA, kShift);
-        if (labels) {
-            const cv::Point2f p = px(*points[i]);
-            put_label(image, std::string(table[i].id), cv::Point(int(p.x) + 4, int(p.y) - 3), scale, colour);
+        cv::circle(image, fixed(*points[i]), 2 << kShift, group_colour(table[i].group), -1, cv::LINE_AA, kShift);
+    }
+    if (!labels) return;
+    const std::vector<FeatureLabel> placed = feature_labels(points, image.size());
+    // Leader lines first, every label over them: a line may pass under a
+    // label, never through its text.
+    for (const FeatureLabel& l : placed) {
+        const cv::Scalar colour = group_colour(table[std::size_t(l.point)].group);
+        if (l.leader) {
+            // From the dot's edge to the box's nearest point, dark under
+            // light so it reads on skin and on the map alike.
+            const cv::Point2f p(points[std::size_t(l.point)]->x, points[std::size_t(l.point)]->y);
+            const cv::Point2f q(std::clamp(p.x, float(l.box.x), float(l.box.x + l.box.width - 1)),
+                                std::clamp(p.y, float(l.box.y), float(l.box.y + l.box.height - 1)));
+            const cv::Point2f d = q - p;
+            const float len = std::hypot(d.x, d.y);
+            const cv::Point2f from = len > 0 ? p + d * (3.0f / len) : p;
+            auto fx = [](cv::Point2f v) { return cv::Point(int(std::lround(v.x * 16)), int(std::lround(v.y * 16))); };
+            cv::line(image, fx(from), fx(q), cv::Scalar(0, 0, 0), 2, cv::LINE_AA, kShift);
+            cv::line(image, fx(from), fx(q), colour, 1, cv::LINE_AA, kShift);
         }
+    }
+    for (const FeatureLabel& l : placed) {
+        const cv::Scalar colour = group_colour(table[std::size_t(l.point)].group);
+        put_label(image, l.text, cv::Point(l.box.x + 1, l.box.y + l.box.height - l.baseline - 1), l.scale, colour);
     }
 }
 
-std::array<std::optional<glm::vec2>, 84> layout_pixels(const expression::FeatureLayout& layout, int width,
+std::vector<FeatureLabel> feature_labels(const std::array<std::optional<glm::vec2>, expression::kFeatureCount>& points, cv::Size image) {
+    const auto& table = fap::feature_points();
+    // Small enough that 84 of them fit a 480-pixel picture, large enough to read.
+    const double scale = std::clamp(image.height / 1450.0, 0.3, 0.5);
+    std::vector<LabelRequest> requests;
+    std::vector<FeatureLabel> labels;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        if (!points[i]) continue;
+        FeatureLabel l;
+        l.point = int(i);
+        l.text = std::string(table[i].id);
+        l.scale = scale;
+        const cv::Size text = cv::getTextSize(l.text, cv::FONT_HERSHEY_SIMPLEX, scale, 1, &l.baseline);
+        // put_label's outline is 3 pixels thick: one more pixel on each side.
+        requests.push_back({cv::Point2f(points[i]->x, points[i]->y),
+                            cv::Size(text.width + 2, text.height + l.baseline + 2)});
+        labels.push_back(l);
+    }
+    const auto placed = place_labels(requests, image);
+    std::vector<FeatureLabel> out;
+    for (std::size_t k = 0; k < labels.size(); ++k) {
+        if (!placed[k]) continue;
+        labels[k].box = placed[k]->box;
+        labels[k].leader = placed[k]->leader;
+        out.push_back(labels[k]);
+    }
+    return out;
+}
+
+std::array<std::optional<glm::vec2>, expression::kFeatureCount> layout_pixels(const expression::FeatureLayout& layout, int width,
                                                        int height) {
-    std::array<std::optional<glm::vec2>, 84> out{};
+    std::array<std::optional<glm::vec2>, expression::kFeatureCount> out{};
     for (std::size_t i = 0; i < out.size(); ++i)
         if (layout.present[i]) out[i] = glm::vec2(layout.points[i].x * width, layout.points[i].y * height);
     return out;

@@ -44,11 +44,26 @@ cv::Mat contact_sheet(const std::string& title, const std::vector<SheetRow>& row
 
 // The feature points (dot + label "2.1" ...) and the feature lines between
 // them, drawn on `image`; points are in pixels of `image` (nullopt: absent).
-void draw_feature_overlay(cv::Mat& image, const std::array<std::optional<glm::vec2>, 84>& points,
+// Labels are placed by feature_labels().
+void draw_feature_overlay(cv::Mat& image, const std::array<std::optional<glm::vec2>, expression::kFeatureCount>& points,
                           const std::vector<expression::FeatureLine>& lines, bool labels = true);
 
+// Where draw_feature_overlay puts each point's label: boxes inside the image
+// that overlap neither one another nor a dot, near their points, with a
+// leader line where a crowd (eyes, lips) pushes one away (label_placement.h).
+// A point whose label finds no room is left out.
+struct FeatureLabel {
+    int point = 0;      // feature point index 0..83
+    std::string text;   // "3.12"
+    cv::Rect box;       // the label's box (text and its outline)
+    bool leader = false;
+    double scale = 0.4;  // font scale
+    int baseline = 0;    // of the text, in pixels
+};
+std::vector<FeatureLabel> feature_labels(const std::array<std::optional<glm::vec2>, expression::kFeatureCount>& points, cv::Size image);
+
 // A layout's points (normalised, y down) in pixels of a width x height image.
-std::array<std::optional<glm::vec2>, 84> layout_pixels(const expression::FeatureLayout& layout, int width,
+std::array<std::optional<glm::vec2>, expression::kFeatureCount> layout_pixels(const expression::FeatureLayout& layout, int width,
                                                        int height);
 
 }  // namespace emoface::apps
