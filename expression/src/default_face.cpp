@@ -17,6 +17,7 @@
 #include <limits>
 #include <random>
 
+#include "emoface/common/constants.h"
 #include "emoface/common/error.h"
 #include "emoface/fap/feature_points.h"
 #include "face_params.h"
@@ -33,7 +34,6 @@ using detail::V3;
 using detail::length;
 constexpr auto length_of = [](V3 v) { return detail::length(v); };
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180.0;
 
 struct Row {
@@ -695,7 +695,7 @@ void Generator::build_mouth_interior(Face& face) {
 }
 
 void Generator::place_feature_points(Face& face) {
-    std::array<bool, 84> placed{};
+    std::array<bool, fap::kFeaturePointCount> placed{};
     auto set_vertex = [&](const char* id, int v) {
         const int k = fap::feature_point_index(id);
         const auto q = face.mesh.point(TriMesh::VertexHandle(v));

@@ -2,17 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <fstream>
-#include <sstream>
 
 #include <glm/geometric.hpp>
 #include <glm/mat3x3.hpp>
 #include <glm/vector_relational.hpp>
 #include <nlohmann/json.hpp>
 
+#include "emoface/common/atomic_file.h"
 #include "emoface/common/error.h"
 #include "emoface/expression/face.h"
+#include "json_reader.h"
 
 namespace emoface::expression {
 
@@ -178,81 +177,48 @@ std::string layout_to_json(const FeatureLayout& layout) {
 }
 
 FeatureLayout layout_from_json(std::string_view text, const std::string& source) {
-    nlohmann::json doc;
-    try {
-        doc = nlohmann::json::parse(text);
-    } catch (const nlohmann::json::exception& e) {
-        fail<InputError>("expression: {}: not valid JSON ({})", source, e.what());
-    }
-    if (!doc.is_object() || !doc.contains("points") || !doc["points"].is_object())
-        fail<InputError>("expression: {}: expected an object \"points\" mapping feature point ids to [x, y]", source);
-    FeatureLayout layout;
-    for (const auto& [id, value] : doc["points"].items()) {
-        const auto index = fap::find_feature_point(id);
-        if (!index) fail<InputError>("expression: {}: unknown feature point \"{}\"", source, id);
-        if (!value.is_array() || value.size() != 2 || !value[0].is_number() || !value[1].is_number() ||
-            !std::isfinite(value[0].get<double>()) || !std::isfinite(value[1].get<double>()))
-            fail<InputError>("expression: {}: feature point {}: expected [x, y] with finite numbers, found {}",
-                             source, id, value.dump());
-        layout.points[*index] = {value[0].get<float>(), value[1].get<float>()};
-        layout.present[*index] = true;
-    }
-    return layout;
+    return detail::read_json_text(text, source, [](detail::JsonReader& root) {
+        root.comment("convention");
+        FeatureLayout layout;
+        for (const auto& [id, value] : root.object("points").entries()) {
+            const auto index = fap::find_feature_point(id);
+            if (!index) value.fail("an MPEG-4 feature point id as the key", "\"" + id + "\"");
+            const auto xy = value.as_numbers<2>();
+            layout.points[*index] = {static_cast<float>(xy[0]), static_cast<float>(xy[1])};
+            layout.present[*index] = true;
+        }
+        return layout;
+    });
 }
 
 void save_layout(const FeatureLayout& layout, const std::string& path) {
-    const std::string temporary = path + ".tmp";
-    {
-        std::ofstream out(temporary, std::ios::binary);
-        out << layout_to_json(layout);
-        if (!out) fail<InputError>("expression: {}: cannot write the layout", path);
-    }
-    if (std::rename(temporary.c_str(), path.c_str()) != 0) {
-        std::remove(temporary.c_str());
-        fail<InputError>("expression: {}: cannot write the layout", path);
-    }
+    write_file_atomically(path, layout_to_json(layout), "expression");
 }
 
-FeatureLayout load_layout(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) fail<InputError>("expression: {}: cannot open the layout", path);
-    std::stringstream text;
-    text << in.rdbuf();
-    return layout_from_json(text.str(), path);
-}
+FeatureLayout load_layout(const std::string& path) { return layout_from_json(detail::read_text_file(path), path); }
 
 std::vector<FeatureLine> load_feature_lines(const std::string& path) {
-    std::ifstream in(path);
-    if (!in) fail<InputError>("expression: {}: cannot open the feature-line file", path);
-    nlohmann::json doc;
-    try {
-        doc = nlohmann::json::parse(in);
-    } catch (const nlohmann::json::exception& e) {
-        fail<InputError>("expression: {}: not valid JSON ({})", path, e.what());
-    }
-    if (!doc.contains("lines") || !doc["lines"].is_array())
-        fail<InputError>("expression: {}: expected an array \"lines\", found none", path);
-    std::vector<FeatureLine> lines;
-    int entry = 0;
-    for (const auto& item : doc["lines"]) {
-        ++entry;
-        if (!item.is_object() || !item.contains("from") || !item.contains("to") ||
-            !item["from"].is_string() || !item["to"].is_string())
-            fail<InputError>("expression: {}: line {} must have string fields \"from\" and \"to\", found {}",
-                             path, entry, item.dump());
-        const auto from = fap::find_feature_point(item["from"].get<std::string>());
-        const auto to = fap::find_feature_point(item["to"].get<std::string>());
-        if (!from || !to)
-            fail<InputError>("expression: {}: line {} names an unknown feature point ({} - {})", path,
-                             entry, item["from"].get<std::string>(), item["to"].get<std::string>());
-        if (*from == *to)
-            fail<InputError>("expression: {}: line {} joins feature point {} to itself", path, entry,
-                             item["from"].get<std::string>());
-        lines.push_back({*from, *to, item.value("region", std::string{})});
-    }
-    if (lines.size() < 40 || lines.size() > 100)
-        fail<InputError>("expression: {}: expected 40 to 100 feature lines, found {}", path, lines.size());
-    return lines;
+    return detail::read_json_file(path, [](detail::JsonReader& root) {
+        root.comment("about");
+        const detail::JsonReader list = root.at("lines");
+        std::vector<FeatureLine> lines;
+        for (detail::JsonReader item : list.elements()) {
+            item = item.as_object();
+            const auto point = [&](const char* key) {
+                const detail::JsonReader id = item.at(key);
+                const auto index = fap::find_feature_point(id.as_string());
+                if (!index) id.fail("an MPEG-4 feature point id");
+                return *index;
+            };
+            FeatureLine line{point("from"), point("to"), item.string("region", "")};
+            if (line.from == line.to) item.at("to").fail("a feature point other than \"from\"");
+            item.finish();
+            lines.push_back(std::move(line));
+        }
+        if (lines.size() < 40 || lines.size() > 100)
+            list.fail("40 to 100 feature lines", std::to_string(lines.size()));
+        return lines;
+    });
 }
 
 std::vector<FeatureLine> lines_for_face(const std::vector<FeatureLine>& lines,

@@ -5,6 +5,7 @@
 #include <map>
 #include <string_view>
 
+#include "emoface/common/constants.h"
 #include "emoface/common/error.h"
 #include "emoface/fap/feature_points.h"
 #include "emoface/fap/fapu.h"
@@ -13,7 +14,6 @@
 namespace emoface::expression {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 using V = std::array<double, 3>;
 
 V sub(V a, V b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
@@ -167,7 +167,7 @@ void FaceRig::build_point_field(const Face& face, double radius_scale) {
     };
 
     // Which feature points take part: those a point FAP moves, and anchors.
-    std::array<bool, 84> driven{};
+    std::array<bool, fap::kFeaturePointCount> driven{};
     for (int f = 3; f <= fap::kFapCount; ++f) {
         if (!is_point_fap(f) && f != 47) continue;
         const auto fp = fap::find_feature_point(fap::fap_info(f).feature_point);
@@ -434,7 +434,7 @@ void FaceRig::build_head(const Face& face) {
             head_weight_[v] = static_cast<float>(smoothstep(head_pivot_[1] - 0.9 * es0, head_pivot_[1], neutral_[v][1]));
 }
 
-void FaceRig::point_displacements(const FapValues& faps, std::array<std::array<double, 3>, 84>& d) const {
+void FaceRig::point_displacements(const FapValues& faps, std::array<std::array<double, 3>, fap::kFeaturePointCount>& d) const {
     for (auto& v : d) v = {0.0, 0.0, 0.0};
     for (int f = 4; f <= fap::kFapCount; ++f) {
         const double value = faps[f - 1];
@@ -464,7 +464,7 @@ void FaceRig::deform(const FapValues& faps, DeformedFace& out) const {
     auto& pos = out.positions;
 
     // Point FAPs.
-    std::array<std::array<double, 3>, 84> fp_d;
+    std::array<std::array<double, 3>, fap::kFeaturePointCount> fp_d;
     point_displacements(faps, fp_d);
     std::vector<std::array<double, 3>> d(system_held_.size(), {0.0, 0.0, 0.0});
     bool any = false;

@@ -106,11 +106,11 @@ private:
     void build_jaw(const Face& face);
     void build_eyes(const Face& face);
     void build_head(const Face& face);
-    void point_displacements(const FapValues& faps, std::array<std::array<double, 3>, 84>& d) const;
+    void point_displacements(const FapValues& faps, std::array<std::array<double, 3>, fap::kFeaturePointCount>& d) const;
 
     std::vector<TriMesh::Point> neutral_;
     std::vector<VertexPart> parts_;
-    std::array<FeaturePointLocation, 84> fps_{};
+    std::array<FeaturePointLocation, fap::kFeaturePointCount> fps_{};
     fap::Fapu fapu_{};
 
     // Point FAPs: feature points in the linear system and the weights of
@@ -120,7 +120,7 @@ private:
     std::vector<bool> system_held_;         // entries (and eyelid margins) the point field holds still
     std::vector<int> influence_start_;      // size vertex_count + 1
     std::vector<Influence> weights_;
-    std::array<int, 84> system_of_fp_{};    // -1 when not in the system
+    std::array<int, fap::kFeaturePointCount> system_of_fp_{};    // -1 when not in the system
 
     // Jaw.
     std::vector<float> jaw_weight_;
