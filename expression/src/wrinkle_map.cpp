@@ -91,8 +91,45 @@ struct Stroke {
     std::vector<glm::vec2> polyline;
     std::vector<float> arc;  // cumulative arc length at each polyline vertex
     float depth, sigma, taper, side;
+    float swell_phase;  // where along the swell noise this stroke starts
+    bool fine;          // a fine secondary line: a plain valley, no shoulders
     glm::vec2 box_min, box_max;
 };
+
+// Deterministic lattice value noise in [-1, 1].
+float lattice(int x, int y, int octave) {
+    std::uint32_t h = static_cast<std::uint32_t>(x) * 0x8da6b343u ^ static_cast<std::uint32_t>(y) * 0xd8163841u ^
+                      static_cast<std::uint32_t>(octave) * 0xcb1ab31fu;
+    h ^= h >> 13;
+    h *= 0x5bd1e995u;
+    h ^= h >> 15;
+    return static_cast<float>(h & 0xffffu) / 32767.5f - 1.0f;
+}
+
+float smoothstep01(float x) {
+    x = std::clamp(x, 0.0f, 1.0f);
+    return x * x * (3.0f - 2.0f * x);
+}
+
+// Smooth 1D value noise in [-1, 1]; `seed` picks an independent row.
+float noise1(float x, int seed) {
+    const float fx = std::floor(x);
+    const int ix = static_cast<int>(fx);
+    const float t = smoothstep01(x - fx);
+    const float a = lattice(ix, seed, 7), b = lattice(ix + 1, seed, 7);
+    return a + (b - a) * t;
+}
+
+// A seeded random number in [0, 1) per (wrinkle, copy, purpose).
+float random01(std::uint32_t seed, int copy, int purpose) {
+    return 0.5f * (lattice(static_cast<int>(seed & 0x7fffffffu), copy, 100 + purpose) + 1.0f) * 0.99998f;
+}
+
+std::uint32_t name_seed(const std::string& name) {
+    std::uint32_t h = 2166136261u;  // FNV-1a
+    for (const char c : name) h = (h ^ static_cast<std::uint8_t>(c)) * 16777619u;
+    return h;
+}
 
 glm::vec2 resolve(const AnchoredPoint& p, const FeatureLayout& layout, float unit) {
     const auto check = [&](int index) {
@@ -125,35 +162,120 @@ std::vector<glm::vec2> catmull_rom(const std::vector<glm::vec2>& points) {
     return out;
 }
 
-std::vector<Stroke> resolve_strokes(const std::vector<WrinkleSpec>& specs, const FeatureLayout& layout) {
+std::vector<float> arc_lengths(const std::vector<glm::vec2>& line) {
+    std::vector<float> arc(line.size(), 0.0f);
+    for (size_t i = 1; i < line.size(); ++i) arc[i] = arc[i - 1] + glm::distance(line[i - 1], line[i]);
+    return arc;
+}
+
+// The part of a curve between arc fractions u0 < u1, resampled at even arc
+// steps, so meander and swell are even along it.
+std::vector<glm::vec2> resample(const std::vector<glm::vec2>& line, float u0, float u1) {
+    constexpr int kSamples = 40;
+    const std::vector<float> arc = arc_lengths(line);
+    const float total = arc.back();
+    std::vector<glm::vec2> out;
+    size_t seg = 0;
+    for (int i = 0; i <= kSamples; ++i) {
+        const float at = total * (u0 + (u1 - u0) * static_cast<float>(i) / kSamples);
+        while (seg + 2 < line.size() && arc[seg + 1] < at) ++seg;
+        const float len = arc[seg + 1] - arc[seg];
+        const float t = len > 0.0f ? std::clamp((at - arc[seg]) / len, 0.0f, 1.0f) : 0.0f;
+        out.push_back(line[seg] + t * (line[seg + 1] - line[seg]));
+    }
+    return out;
+}
+
+// Each vertex moved sideways (perpendicular to the curve) by offset(arc).
+template <typename OffsetFn>
+std::vector<glm::vec2> displace(const std::vector<glm::vec2>& line, OffsetFn&& offset) {
+    const std::vector<float> arc = arc_lengths(line);
+    std::vector<glm::vec2> out(line.size());
+    for (size_t i = 0; i < line.size(); ++i) {
+        const glm::vec2 a = line[i == 0 ? 0 : i - 1], b = line[std::min(i + 1, line.size() - 1)];
+        const glm::vec2 d = b - a;
+        const float len = glm::length(d);
+        const glm::vec2 normal = len > 0.0f ? glm::vec2(-d.y, d.x) / len : glm::vec2(0.0f);
+        out[i] = line[i] + offset(arc[i]) * normal;
+    }
+    return out;
+}
+
+Stroke make_stroke(WrinkleProfile profile, std::vector<glm::vec2> polyline, float depth, float sigma, float taper,
+                   float side, float swell_phase, bool fine, float reach) {
+    Stroke s;
+    s.profile = profile;
+    s.polyline = std::move(polyline);
+    s.arc = arc_lengths(s.polyline);
+    s.depth = depth;
+    s.sigma = sigma;
+    s.taper = taper;
+    s.side = side;
+    s.swell_phase = swell_phase;
+    s.fine = fine;
+    s.box_min = s.box_max = s.polyline[0];
+    for (const glm::vec2& p : s.polyline) {
+        s.box_min = glm::min(s.box_min, p);
+        s.box_max = glm::max(s.box_max, p);
+    }
+    s.box_min -= glm::vec2(reach);
+    s.box_max += glm::vec2(reach);
+    return s;
+}
+
+std::vector<Stroke> resolve_strokes(const std::vector<WrinkleSpec>& specs, const FoldShape& shape,
+                                    const FeatureLayout& layout) {
     const float unit = layout.face_unit();
     std::vector<Stroke> strokes;
     for (const WrinkleSpec& spec : specs) {
         std::vector<glm::vec2> base;
         for (const AnchoredPoint& p : spec.points) base.push_back(resolve(p, layout, unit));
         const std::vector<glm::vec2> curve = catmull_rom(base);
+        const std::uint32_t seed = name_seed(spec.name);
+        const float sigma = spec.width * unit;
+        // A valley with its shoulders on the wide flank reaches this far.
+        const float wide = 1.0f + shape.asymmetry;
+        const float reach = spec.profile == WrinkleProfile::Fold
+                                ? 6.0f * wide * sigma
+                                : (shape.shoulder_offset + 3.0f * shape.shoulder_width) * wide * sigma;
+        if (curve.size() == 1) {  // a round mark: no along-the-fold shape
+            strokes.push_back(make_stroke(spec.profile, curve, spec.depth * unit, sigma, 0.0f, spec.side, 0.0f,
+                                          false, 3.0f * sigma));
+            continue;
+        }
+        const bool varied = spec.count > 1;
         float depth = spec.depth;
+        glm::vec2 shift{0.0f};
         for (int copy = 0; copy < spec.count; ++copy, depth *= spec.depth_falloff) {
-            Stroke s;
-            s.profile = spec.profile;
-            const glm::vec2 shift = static_cast<float>(copy) * unit * glm::vec2(spec.step.x, -spec.step.y);
-            for (const glm::vec2& p : curve) s.polyline.push_back(p + shift);
-            s.arc.assign(s.polyline.size(), 0.0f);
-            for (size_t i = 1; i < s.polyline.size(); ++i)
-                s.arc[i] = s.arc[i - 1] + glm::distance(s.polyline[i - 1], s.polyline[i]);
-            s.depth = depth * unit;
-            s.sigma = spec.width * unit;
-            s.taper = spec.taper;
-            s.side = spec.side;
-            const float reach = (spec.profile == WrinkleProfile::Fold ? 5.0f : 3.0f) * s.sigma;
-            s.box_min = s.box_max = s.polyline[0];
-            for (const glm::vec2& p : s.polyline) {
-                s.box_min = glm::min(s.box_min, p);
-                s.box_max = glm::max(s.box_max, p);
+            // Parallel folds differ: spacing, length and depth each vary a
+            // little, seeded by the wrinkle's name, so the result is
+            // deterministic yet no two copies are the same stroke.
+            if (copy > 0)
+                shift += (1.0f + shape.copy_spacing * (2.0f * random01(seed, copy, 0) - 1.0f)) * unit *
+                         glm::vec2(spec.step.x, -spec.step.y);
+            const float u0 = varied ? shape.copy_length * random01(seed, copy, 1) : 0.0f;
+            const float u1 = varied ? 1.0f - shape.copy_length * random01(seed, copy, 2) : 1.0f;
+            const float copy_depth =
+                depth * (varied ? 1.0f + shape.copy_depth * (2.0f * random01(seed, copy, 3) - 1.0f) : 1.0f);
+            std::vector<glm::vec2> line = resample(curve, u0, u1);
+            for (glm::vec2& p : line) p += shift;
+            const int meander_row = static_cast<int>((seed >> 8) & 0xffff) + 31 * copy;
+            const float wavelength = shape.meander_wavelength * unit;
+            line = displace(line, [&](float at) { return shape.meander * sigma * noise1(at / wavelength, meander_row); });
+            const float phase = 97.0f * random01(seed, copy, 4);
+            if (spec.profile == WrinkleProfile::Groove && shape.fine_depth > 0.0f) {
+                // The finer scale: one shallow line beside the fold, on a
+                // seeded side, over a seeded stretch of its middle.
+                const float side = random01(seed, copy, 5) < 0.5f ? -1.0f : 1.0f;
+                const float start = (1.0f - shape.fine_length) * random01(seed, copy, 6);
+                std::vector<glm::vec2> fine = resample(line, start, start + shape.fine_length);
+                fine = displace(fine, [&](float) { return side * shape.fine_offset * sigma; });
+                strokes.push_back(make_stroke(WrinkleProfile::Groove, std::move(fine),
+                                              shape.fine_depth * copy_depth * unit, shape.fine_width * sigma, 0.4f,
+                                              spec.side, phase + 13.0f, true, 3.0f * shape.fine_width * sigma));
             }
-            s.box_min -= glm::vec2(reach);
-            s.box_max += glm::vec2(reach);
-            strokes.push_back(std::move(s));
+            strokes.push_back(make_stroke(spec.profile, std::move(line), copy_depth * unit, sigma, spec.taper,
+                                          spec.side, phase, false, reach));
         }
     }
     return strokes;
@@ -162,18 +284,13 @@ std::vector<Stroke> resolve_strokes(const std::vector<WrinkleSpec>& specs, const
 // A Gaussian that reaches exactly zero at 3 sigma, so skin away from a
 // wrinkle stays exactly flat.
 float bump(float d, float sigma) {
-    const float x = d / sigma;
+    const float x = std::abs(d) / sigma;
     if (x >= 3.0f) return 0.0f;
     constexpr float kTail = 0.011108996538f;  // exp(-4.5)
     return (std::exp(-0.5f * x * x) - kTail) / (1.0f - kTail);
 }
 
-float smoothstep01(float x) {
-    x = std::clamp(x, 0.0f, 1.0f);
-    return x * x * (3.0f - 2.0f * x);
-}
-
-float stroke_height(const Stroke& s, glm::vec2 x) {
+float stroke_height(const Stroke& s, const FoldShape& shape, float unit, glm::vec2 x) {
     float best = 1e30f, signed_best = 0.0f, arc_at = 0.0f;
     if (s.polyline.size() == 1) {
         best = glm::distance(x, s.polyline[0]);
@@ -192,32 +309,44 @@ float stroke_height(const Stroke& s, glm::vec2 x) {
             }
         }
     }
+    if (s.polyline.size() == 1) {
+        switch (s.profile) {
+            case WrinkleProfile::Bulge: return s.depth * bump(best, s.sigma);
+            default: return -s.depth * bump(best, s.sigma);
+        }
+    }
+    // Along the fold: depth fades in smoothly at both ends, the width narrows
+    // with it (no blunt ends), and the depth swells and thins gently.
     float window = 1.0f;
-    if (s.polyline.size() > 1 && s.taper > 0.0f) {
+    if (s.taper > 0.0f) {
         const float u = arc_at / std::max(s.arc.back(), 1e-12f);
         window = smoothstep01(u / s.taper) * smoothstep01((1.0f - u) / s.taper);
     }
+    if (window <= 0.0f) return 0.0f;
+    const float swell = 1.0f + shape.swell * noise1(arc_at / (shape.meander_wavelength * unit) + s.swell_phase, 3);
+    const float depth = s.depth * window * swell;
+    const float sigma = s.sigma * (shape.width_taper + (1.0f - shape.width_taper) * std::sqrt(window));
+    if (s.fine) return -depth * bump(best, sigma);
+    // Across: the flank on the `side` of the curve is steeper than the other.
+    const bool steep = s.side * signed_best >= 0.0f;
+    const float flank = sigma * (steep ? 1.0f - shape.asymmetry : 1.0f + shape.asymmetry);
     switch (s.profile) {
         case WrinkleProfile::Groove:
         case WrinkleProfile::Dimple:
-            return -s.depth * window * bump(best, s.sigma);
+            // Compressed skin buckles into a narrow valley with broad rounded
+            // crests beside it (FIDELITY.md 6, HARR).
+            return depth * (-bump(best, flank) +
+                            shape.shoulder * bump(best - shape.shoulder_offset * flank, shape.shoulder_width * flank));
         case WrinkleProfile::Bulge:
-            return s.depth * window * bump(best, s.sigma);
+            return depth * bump(best, sigma);
         case WrinkleProfile::Fold:
-            return s.depth * window *
-                   (-bump(best, s.sigma) + 0.5f * bump(s.side * signed_best - 2.0f * s.sigma, 1.5f * s.sigma));
+            // The cheek bulges over the `side` flank; the other keeps a small shoulder.
+            return depth * (-bump(best, flank) + 0.5f * bump(s.side * signed_best - 2.0f * sigma, 1.5f * sigma) +
+                            0.5f * shape.shoulder *
+                                bump(-s.side * signed_best - shape.shoulder_offset * flank,
+                                     shape.shoulder_width * flank));
     }
     return 0.0f;
-}
-
-// Deterministic lattice value noise in [-1, 1].
-float lattice(int x, int y, int octave) {
-    std::uint32_t h = static_cast<std::uint32_t>(x) * 0x8da6b343u ^ static_cast<std::uint32_t>(y) * 0xd8163841u ^
-                      static_cast<std::uint32_t>(octave) * 0xcb1ab31fu;
-    h ^= h >> 13;
-    h *= 0x5bd1e995u;
-    h ^= h >> 15;
-    return static_cast<float>(h & 0xffffu) / 32767.5f - 1.0f;
 }
 
 float value_noise(glm::vec2 p, int octave) {
@@ -251,6 +380,43 @@ struct SkinMask {
     }
 };
 
+// Where wrinkles may be: below the hairline (a polyline through the hair
+// border points 11.2, 11.1, 11.3, flat beyond its ends) and inside the map.
+// A fold reaching the hair fades out over `fade` below the hairline (by its
+// centreline, so it tapers along its length), and no height at all lands on
+// or above the hairline (by pixel).
+struct WrinkleArea {
+    std::vector<glm::vec2> hairline;  // sorted by x
+    float fade = 0.0f, edge = 0.0f;
+    explicit WrinkleArea(const FeatureLayout& layout) {
+        for (const char* id : {"11.2", "11.1", "11.3"}) {
+            const int i = fap::feature_point_index(id);
+            if (layout.present[i]) hairline.push_back(layout.points[i]);
+        }
+        std::sort(hairline.begin(), hairline.end(), [](glm::vec2 a, glm::vec2 b) { return a.x < b.x; });
+        fade = 0.15f * layout.face_unit();
+        edge = 0.03f * layout.face_unit();
+    }
+    float hair_y(float x) const {
+        if (hairline.empty()) return -1e30f;
+        if (x <= hairline.front().x) return hairline.front().y;
+        for (size_t i = 0; i + 1 < hairline.size(); ++i)
+            if (x <= hairline[i + 1].x) {
+                const float span = hairline[i + 1].x - hairline[i].x;
+                const float t = span > 0.0f ? (x - hairline[i].x) / span : 0.0f;
+                return hairline[i].y + t * (hairline[i + 1].y - hairline[i].y);
+            }
+        return hairline.back().y;
+    }
+    // For a fold's centreline point: 1 well below the hairline, 0 at it.
+    float centreline(glm::vec2 p) const { return smoothstep01((p.y - hair_y(p.x)) / fade); }
+    // For any pixel: 0 on or above the hairline and at the map's edge.
+    float pixel(glm::vec2 p) const {
+        const float to_edge = std::min({p.x, 1.0f - p.x, p.y, 1.0f - p.y});
+        return smoothstep01((p.y - hair_y(p.x)) / (0.3f * fade)) * smoothstep01(to_edge / edge);
+    }
+};
+
 // Rows on the shared pool, a few at a time; each row is written by one call.
 template <typename RowFn>
 void for_each_row_band(int rows, RowFn&& fn) {
@@ -274,6 +440,34 @@ WrinkleLibrarySpec load_wrinkle_spec(const std::string& path) {
                 spec.wrinkles[key].push_back(read_wrinkle(item));
         }
         emotions.finish();
+        if (root.has("fold_shape")) {
+            JsonReader f = root.object("fold_shape");
+            f.comment("why");
+            FoldShape& fs = spec.fold;
+            fs.shoulder = read_number(f, "shoulder", fs.shoulder, 0.0f, 1.0f);
+            fs.shoulder_offset = read_number(f, "shoulder_offset", fs.shoulder_offset, 0.5f, 5.0f);
+            fs.shoulder_width = read_number(f, "shoulder_width", fs.shoulder_width, 0.2f, 3.0f);
+            fs.asymmetry = read_number(f, "asymmetry", fs.asymmetry, 0.0f, 0.8f);
+            fs.meander = read_number(f, "meander", fs.meander, 0.0f, 3.0f);
+            fs.meander_wavelength = read_number(f, "meander_wavelength", fs.meander_wavelength, 0.01f, 2.0f);
+            fs.swell = read_number(f, "swell", fs.swell, 0.0f, 0.9f);
+            fs.width_taper = read_number(f, "width_taper", fs.width_taper, 0.05f, 1.0f);
+            fs.copy_length = read_number(f, "copy_length", fs.copy_length, 0.0f, 0.45f);
+            fs.copy_depth = read_number(f, "copy_depth", fs.copy_depth, 0.0f, 0.9f);
+            fs.copy_spacing = read_number(f, "copy_spacing", fs.copy_spacing, 0.0f, 0.9f);
+            fs.fine_depth = read_number(f, "fine_depth", fs.fine_depth, 0.0f, 1.0f);
+            fs.fine_width = read_number(f, "fine_width", fs.fine_width, 0.1f, 1.0f);
+            fs.fine_offset = read_number(f, "fine_offset", fs.fine_offset, 1.0f, 8.0f);
+            fs.fine_length = read_number(f, "fine_length", fs.fine_length, 0.1f, 1.0f);
+            f.finish();
+        }
+        if (root.has("cavity")) {
+            JsonReader c = root.object("cavity");
+            c.comment("why");
+            spec.cavity.full_depth = read_number(c, "full_depth", spec.cavity.full_depth, 1e-4f, 1.0f);
+            spec.cavity.darkest = read_number(c, "darkest", spec.cavity.darkest, 0.0f, 1.0f);
+            c.finish();
+        }
         if (root.has("neutral_skin_detail")) {
             JsonReader d = root.object("neutral_skin_detail");
             spec.neutral_detail.amplitude = read_number(d, "amplitude", 0.0f, 0.0f, 0.05f);
@@ -289,7 +483,17 @@ std::vector<float> render_height_field(const WrinkleLibrarySpec& spec, WrinkleKe
                                        const FeatureLayout& layout, int size) {
     if (size < 16 || size > 8192)
         fail<InputError>("expression: render_height_field(): size must be in [16, 8192], found {}", size);
-    const std::vector<Stroke> strokes = resolve_strokes(spec.wrinkles[static_cast<int>(key)], layout);
+    std::vector<Stroke> strokes = resolve_strokes(spec.wrinkles[static_cast<int>(key)], spec.fold, layout);
+    const WrinkleArea area(layout);
+    for (Stroke& s : strokes) {
+        // Each fold fades by its centreline's distance below the hairline:
+        // the depth at the closest centreline point to the hair decides.
+        float keep = 1.0f;
+        for (const glm::vec2& p : s.polyline) keep = std::min(keep, area.centreline(p));
+        s.depth *= keep;
+    }
+    strokes.erase(std::remove_if(strokes.begin(), strokes.end(), [](const Stroke& s) { return s.depth <= 0.0f; }),
+                  strokes.end());
     const bool detail = key == WrinkleKey::Neutral && spec.neutral_detail.amplitude > 0.0f;
     const SkinMask mask(layout);
     const float unit = layout.face_unit();
@@ -302,8 +506,10 @@ std::vector<float> render_height_field(const WrinkleLibrarySpec& spec, WrinkleKe
             if (y < s.box_min.y || y > s.box_max.y) continue;
             const int c0 = std::max(0, static_cast<int>(std::floor(s.box_min.x * size)));
             const int c1 = std::min(size - 1, static_cast<int>(std::ceil(s.box_max.x * size)));
-            for (int col = c0; col <= c1; ++col) out[col] += stroke_height(s, {(col + 0.5f) * inv, y});
+            for (int col = c0; col <= c1; ++col) out[col] += stroke_height(s, spec.fold, unit, {(col + 0.5f) * inv, y});
         }
+        for (int col = 0; col < size; ++col)
+            if (out[col] != 0.0f) out[col] *= area.pixel({(col + 0.5f) * inv, y});
         if (detail) {
             const SkinDetail& d = spec.neutral_detail;
             for (int col = 0; col < size; ++col) {
@@ -320,8 +526,11 @@ std::vector<float> render_height_field(const WrinkleLibrarySpec& spec, WrinkleKe
     return height;
 }
 
-NormalMap height_to_normal_map(const std::vector<float>& height, int size, float face_unit) {
-    (void)face_unit;  // heights and positions share normalised units; kept for painted maps
+NormalMap height_to_normal_map(const std::vector<float>& height, int size, float face_unit,
+                               const CavitySpec& cavity) {
+    // Heights and positions share normalised units; the cavity's full depth
+    // is in face units.
+    const float full_depth = cavity.full_depth * face_unit;
     NormalMap map;
     map.width = map.height = size;
     map.rgba.resize(static_cast<size_t>(size) * size * 4);
@@ -343,7 +552,10 @@ NormalMap height_to_normal_map(const std::vector<float>& height, int size, float
             px[0] = encode(-dx / len);
             px[1] = encode(-dy / len);
             px[2] = encode(1.0f / len);
-            px[3] = 255;
+            // The cavity: a valley occludes light in proportion to its depth.
+            const float h = height[static_cast<size_t>(r) * size + c];
+            const float occlusion = h < 0.0f ? std::min(-h / full_depth, 1.0f) : 0.0f;
+            px[3] = h < 0.0f ? encode(2.0f * (1.0f - (1.0f - cavity.darkest) * occlusion) - 1.0f) : 255;
         }
     });
     return map;
@@ -353,7 +565,7 @@ NormalMap generate_wrinkle_map(const WrinkleLibrarySpec& spec, WrinkleKey key,
                                const FeatureLayout& layout, int size) {
     if (size < 256 || size > 4096)
         fail<InputError>("expression: generate_wrinkle_map(): size must be in [256, 4096], found {}", size);
-    return height_to_normal_map(render_height_field(spec, key, layout, size), size, layout.face_unit());
+    return height_to_normal_map(render_height_field(spec, key, layout, size), size, layout.face_unit(), spec.cavity);
 }
 
 }  // namespace emoface::expression

@@ -373,7 +373,7 @@ INSTANTIATE_TEST_SUITE_P(
                 "emotions.joy[0].dpeth: expected a known key (name, profile, points, depth, width, taper, count, "
                 "step, depth_falloff, side, why), found \"dpeth\""},
         BadSpec{"typo_at_top", R"({"emotions": {}, "neutral_skin_detial": {}})",
-                "neutral_skin_detial: expected a known key (emotions, neutral_skin_detail, about), "
+                "neutral_skin_detial: expected a known key (emotions, fold_shape, cavity, neutral_skin_detail, about), "
                 "found \"neutral_skin_detial\""},
         BadSpec{"no_points", R"({"emotions": {"joy": [{"name": "a"}]}})",
                 "emotions.joy[0].points: expected a value, found no such key"},

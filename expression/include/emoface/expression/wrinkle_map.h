@@ -55,6 +55,34 @@ struct WrinkleSpec {
     float side = 1.0f;     // Fold: which side of the curve bulges (+1 left of travel)
 };
 
+// How every groove and fold is shaped, for all wrinkles alike (wrinkles.json
+// "fold_shape"; the reasoning is there). Lengths are in units of the
+// wrinkle's width (its sigma) unless noted.
+struct FoldShape {
+    float shoulder = 0.3f;           // crest height beside a groove, fraction of its depth
+    float shoulder_offset = 2.2f;    // crest distance from the valley floor
+    float shoulder_width = 1.3f;     // crest sigma
+    float asymmetry = 0.3f;          // one flank (sigma * (1 - a)) steeper than the other (1 + a)
+    float meander = 0.5f;            // sideways wander of the valley floor
+    float meander_wavelength = 0.25f;  // face units
+    float swell = 0.35f;             // depth variation along the fold, +- fraction
+    float width_taper = 0.5f;        // width at the very ends, fraction of the middle's
+    float copy_length = 0.25f;       // parallel copies: each end trimmed by up to this fraction
+    float copy_depth = 0.25f;        // parallel copies: depth varied by +- this fraction
+    float copy_spacing = 0.2f;       // parallel copies: step varied by +- this fraction
+    float fine_depth = 0.22f;        // fine lines beside each groove, fraction of its depth
+    float fine_width = 0.45f;        // their sigma
+    float fine_offset = 3.6f;        // their distance from the valley floor
+    float fine_length = 0.55f;       // their length, fraction of the groove's
+};
+
+// Cavity (ambient occlusion of a valley) stored in a map's alpha: 1 on open
+// skin and on raised skin, falling in valleys.
+struct CavitySpec {
+    float full_depth = 0.025f;  // face units: a valley this deep gets the darkest cavity
+    float darkest = 0.35f;      // alpha at or below full_depth
+};
+
 struct SkinDetail {
     float amplitude = 0.0f;  // face units
     float scale = 0.02f;     // face units: size of the finest cell
@@ -64,6 +92,8 @@ struct SkinDetail {
 struct WrinkleLibrarySpec {
     std::array<std::vector<WrinkleSpec>, kWrinkleKeyCount> wrinkles;  // by WrinkleKey
     SkinDetail neutral_detail;
+    FoldShape fold;
+    CavitySpec cavity;
 };
 
 // Loads data/expression/wrinkles.json; errors name the file, emotion and
@@ -77,13 +107,19 @@ struct NormalMap {
 };
 
 // Height field (face units, 0 = flat skin) of one key's wrinkles at `layout`,
-// size x size samples at pixel centres. Deterministic.
+// size x size samples at pixel centres. Deterministic. Every wrinkle fades
+// out below the hairline (feature points 11.2, 11.1, 11.3) and before the
+// map's edge, so no fold sits on the hair or is cut off.
 std::vector<float> render_height_field(const WrinkleLibrarySpec& spec, WrinkleKey key,
                                        const FeatureLayout& layout, int size);
 
-// Tangent-space normal map of a height field (see the convention above).
-// Where the height field is locally flat the pixel is exactly (128, 128, 255).
-NormalMap height_to_normal_map(const std::vector<float>& height, int size, float face_unit);
+// Tangent-space normal map of a height field (see the convention above),
+// with the cavity in alpha: exactly 255 where the height is >= 0, lower in
+// valleys (heights in normalised texture units; face_unit scales
+// cavity.full_depth to them). Where the height field is locally flat the
+// pixel is exactly (128, 128, 255, 255).
+NormalMap height_to_normal_map(const std::vector<float>& height, int size, float face_unit,
+                               const CavitySpec& cavity = {});
 
 // render_height_field + height_to_normal_map. size in [256, 4096].
 NormalMap generate_wrinkle_map(const WrinkleLibrarySpec& spec, WrinkleKey key,
