@@ -93,7 +93,9 @@ FaceSceneOptions::FaceSceneOptions() {
     skin.shininess = 20.0f;
     skin.specular_color = glm::vec3(0.35f);
     eyes.uses_wrinkle_map = false;
-    eyes.shininess = 90.0f;
+    // The cornea is a smooth wet surface: a tight lobe gives the small bright
+    // catch-light that makes an eye read as alive (a broad one only greys it).
+    eyes.shininess = 1000.0f;
     eyes.specular_color = glm::vec3(1.0f);
     mouth.uses_wrinkle_map = false;
     mouth.shininess = 12.0f;
