@@ -33,7 +33,12 @@ TEST_F(InfoCli, BundledTour) {
     EXPECT_NE(r.out.find("  duration  2.000 s\n"), std::string::npos);
     EXPECT_NE(r.out.find("    31 raise_l_i_eyebrow      -120 .. 200\n"), std::string::npos);
     EXPECT_NE(r.out.find("  FAP 1     not used\n"), std::string::npos);
-    EXPECT_NE(r.out.find("  FAP 2     31 frames, joy up to 63, anger up to 63\n"), std::string::npos);
+    EXPECT_NE(r.out.find("  moving    22 low-level FAPs, 2 expressions (FAP 2)\n"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("  FAP 2     31 frames, 2 expressions (intensity 0..63; frames counted from 0):\n"
+                         "    joy       intensity  0..63  19 frames in 24..49\n"
+                         "    anger     intensity  0..63  24 frames in 12..35\n"),
+              std::string::npos)
+        << r.out;
     EXPECT_NE(r.out.find("  warnings  none\n"), std::string::npos);
 }
 
