@@ -29,13 +29,8 @@ using emoface::testing::CommandResult;
 using emoface::testing::read_file;
 using emoface::testing::run_emoface;
 using emoface::testing::RunOptions;
+using emoface::testing::without_display;
 using Args = std::vector<std::string>;
-
-RunOptions without_display() {
-    RunOptions o;
-    o.unset_env = {"DISPLAY", "WAYLAND_DISPLAY"};
-    return o;
-}
 
 const std::string kData = EMOFACE_DATA_DIR;
 const std::string kTour = kData + "/fap/tour.fap";  // 50 frames at 25 frames/s

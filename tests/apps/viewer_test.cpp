@@ -144,19 +144,10 @@ TEST(ViewerControls, LightKeepsItsDirectionAndDragsAroundTheFace) {
 
 using emoface::testing::CommandResult;
 using emoface::testing::EmofaceProcess;
-using emoface::testing::RunOptions;
 using emoface::testing::run_emoface;
 
-RunOptions without_display() {
-    RunOptions o;
-    o.unset_env = {"DISPLAY"};
-    return o;
-}
-RunOptions on_display(const std::string& display) {
-    RunOptions o;
-    o.set_env = {{"DISPLAY", display}};
-    return o;
-}
+using emoface::testing::on_display;
+using emoface::testing::without_display;
 
 class ViewCommand : public ::testing::Test {
 protected:

@@ -54,6 +54,18 @@ std::vector<char*> pointers(std::vector<std::string>& strings) {
 
 }  // namespace
 
+RunOptions without_display() {
+    RunOptions o;
+    o.unset_env = {"DISPLAY", "WAYLAND_DISPLAY"};
+    return o;
+}
+
+RunOptions on_display(const std::string& display) {
+    RunOptions o;
+    o.set_env = {{"DISPLAY", display}};
+    return o;
+}
+
 std::vector<std::string> args_with(std::vector<std::string> first, const std::vector<std::string>& rest) {
     first.insert(first.end(), rest.begin(), rest.end());
     return first;

@@ -18,6 +18,11 @@ struct RunOptions {
     double timeout_seconds = 300;  // run_emoface's limit; then killed: timed_out, exit_code -1
 };
 
+// A run with no display at all (DISPLAY and WAYLAND_DISPLAY unset), and one
+// on the X display `display` (":93").
+RunOptions without_display();
+RunOptions on_display(const std::string& display);
+
 struct CommandResult {
     int exit_code = -1;  // -1 when killed by a signal or the time limit
     bool timed_out = false;
