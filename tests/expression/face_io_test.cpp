@@ -11,6 +11,7 @@
 #include "emoface/common/error.h"
 #include "emoface/expression/face_io.h"
 #include "emoface/fap/feature_points.h"
+#include "support/expect_error.h"
 #include "test_face.h"
 
 namespace emoface::expression {
@@ -150,12 +151,8 @@ TEST_F(FaceFiles, ReadersNameTheFileLineAndProblem) {
     };
     for (const auto& c : objs) {
         const std::string obj = write("bad.obj", c.obj);
-        try {
-            load_obj_with_fdp(obj, fdp);
-            ADD_FAILURE() << c.message;
-        } catch (const InputError& e) {
-            EXPECT_EQ(std::string(e.what()), "expression: " + obj + c.message);
-        }
+        emoface::testing::expect_error<InputError>([&] { load_obj_with_fdp(obj, fdp); },
+                                                   "expression: " + obj + c.message);
     }
     const std::string obj = write("user.obj", user_obj());
     struct FdpCase {
@@ -189,12 +186,8 @@ TEST_F(FaceFiles, ReadersNameTheFileLineAndProblem) {
     };
     for (const auto& c : fdps) {
         const std::string f = write("bad.fdp.json", c.fdp);
-        try {
-            load_obj_with_fdp(obj, f);
-            ADD_FAILURE() << c.message;
-        } catch (const InputError& e) {
-            EXPECT_EQ(std::string(e.what()), "expression: " + f + c.message);
-        }
+        emoface::testing::expect_error<InputError>([&] { load_obj_with_fdp(obj, f); },
+                                                   "expression: " + f + c.message);
     }
     // A face without the points FAPU need says which.
     try {
