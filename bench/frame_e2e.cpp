@@ -22,11 +22,13 @@
 #include <cuda_runtime.h>
 #endif
 
+#include "emoface/common/atomic_file.h"
 #include "emoface/common/error.h"
 #include "emoface/expression/default_face.h"
 #include "emoface/fap/fap_io.h"
 #include "emoface/render/face_assets.h"
 #include "emoface/render/face_scene.h"
+#include "emoface/render/image_diff.h"
 #include "emoface/render/platform.h"
 
 namespace {
@@ -50,15 +52,10 @@ struct Series {
 };
 
 void write_ppm(const std::string& path, const render::ImageRGBA8& img) {
-    const std::string temp = path + ".tmp";
-    {
-        std::ofstream f(temp, std::ios::binary);
-        f << "P6\n" << img.width << " " << img.height << "\n255\n";
-        for (std::size_t i = 0; i < img.pixels.size(); i += 4)
-            f.write(reinterpret_cast<const char*>(&img.pixels[i]), 3);
-        if (!f) fail("frame_e2e: cannot write {}", path);
-    }
-    if (std::rename(temp.c_str(), path.c_str()) != 0) fail("frame_e2e: cannot write {}", path);
+    std::string bytes = fmt::format("P6\n{} {}\n255\n", img.width, img.height);
+    for (std::size_t i = 0; i < img.pixels.size(); i += 4)
+        bytes.append(reinterpret_cast<const char*>(&img.pixels[i]), 3);
+    write_file_atomically(path, bytes, "frame_e2e");
 }
 
 render::ImageRGBA8 read_ppm(const std::string& path) {
@@ -78,17 +75,6 @@ render::ImageRGBA8 read_ppm(const std::string& path) {
         img.pixels[4 * i + 3] = 255;
     }
     return img;
-}
-
-double psnr(const render::ImageRGBA8& a, const render::ImageRGBA8& b) {
-    double se = 0.0;
-    for (std::size_t i = 0; i < a.pixels.size(); ++i) {
-        if (i % 4 == 3) continue;
-        const double d = double(a.pixels[i]) - double(b.pixels[i]);
-        se += d * d;
-    }
-    const double mse = se / (3.0 * a.width * a.height);
-    return mse == 0.0 ? INFINITY : 10.0 * std::log10(255.0 * 255.0 / mse);
 }
 
 void fence() {
@@ -114,6 +100,9 @@ int main(int argc, char** argv) {
     app.add_option("--width", width)->check(CLI::Range(16, 8192));
     app.add_option("--height", height)->check(CLI::Range(16, 8192));
     app.add_option("--samples", samples, "MSAA samples")->check(CLI::Range(1, 16));
+    std::string shading = "skin";
+    app.add_option("--shading", shading, "skin (data/render/skin.json) or thesis (Blinn-Phong)")
+        ->check(CLI::IsMember({"skin", "thesis"}));
     app.add_option("--face-scale", face_scale, "default face mesh resolution scale")->check(CLI::Range(0.1, 2.0));
     app.add_option("--backend", backend_name, "morph backend: auto, cpu, cuda");
     app.add_option("--tangents", frames_name,
@@ -173,6 +162,8 @@ int main(int argc, char** argv) {
         render::DrawOptions draw;
         draw.camera = scene.frontal_camera(float(width) / float(height));
         draw.light = scene.portrait_light();
+        draw.shading = shading == "thesis" ? render::Shading::Thesis : render::Shading::Skin;
+        draw.skin = render::load_skin_shading(data_dir + "/render/skin.json");
 
         auto frame_at = [&](long i) {
             return stream.sample(double(i % std::max<long>(1, long(stream.frames.size()))) / stream.fps);
@@ -200,7 +191,7 @@ int main(int argc, char** argv) {
                 if (ref.width != img.width || ref.height != img.height)
                     fail("frame_e2e: reference {} is {}x{}, the frame {}x{}", compare, ref.width,
                          ref.height, img.width, img.height);
-                const double p = psnr(img, ref);
+                const double p = render::diff_images(img, ref).psnr();
                 std::printf("  check frame %d vs %s: PSNR %.1f dB (minimum %.1f)\n", check_frame,
                             compare.c_str(), p, min_psnr);
                 write_ppm("frame_e2e_check.ppm", img);
