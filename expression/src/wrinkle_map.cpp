@@ -90,6 +90,7 @@ struct Stroke {
     WrinkleProfile profile;
     std::vector<glm::vec2> polyline;
     std::vector<float> arc;  // cumulative arc length at each polyline vertex
+    std::vector<float> keep;  // depth factor at each vertex (1; less near the hairline)
     float depth, sigma, taper, side;
     float swell_phase;  // where along the swell noise this stroke starts
     bool fine;          // a fine secondary line: a plain valley, no shoulders
@@ -207,6 +208,7 @@ Stroke make_stroke(WrinkleProfile profile, std::vector<glm::vec2> polyline, floa
     s.profile = profile;
     s.polyline = std::move(polyline);
     s.arc = arc_lengths(s.polyline);
+    s.keep.assign(s.polyline.size(), 1.0f);
     s.depth = depth;
     s.sigma = sigma;
     s.taper = taper;
@@ -291,7 +293,7 @@ float bump(float d, float sigma) {
 }
 
 float stroke_height(const Stroke& s, const FoldShape& shape, float unit, glm::vec2 x) {
-    float best = 1e30f, signed_best = 0.0f, arc_at = 0.0f;
+    float best = 1e30f, signed_best = 0.0f, arc_at = 0.0f, keep = 1.0f;
     if (s.polyline.size() == 1) {
         best = glm::distance(x, s.polyline[0]);
     } else {
@@ -303,6 +305,7 @@ float stroke_height(const Stroke& s, const FoldShape& shape, float unit, glm::ve
             if (d < best) {
                 best = d;
                 arc_at = s.arc[i] + t * (s.arc[i + 1] - s.arc[i]);
+                keep = s.keep[i] + t * (s.keep[i + 1] - s.keep[i]);
                 // Image y points down: a positive cross is the face's-left side of travel.
                 const float cross = ab.x * (x.y - a.y) - ab.y * (x.x - a.x);
                 signed_best = cross >= 0.0f ? d : -d;
@@ -324,7 +327,7 @@ float stroke_height(const Stroke& s, const FoldShape& shape, float unit, glm::ve
     }
     if (window <= 0.0f) return 0.0f;
     const float swell = 1.0f + shape.swell * noise1(arc_at / (shape.meander_wavelength * unit) + s.swell_phase, 3);
-    const float depth = s.depth * window * swell;
+    const float depth = s.depth * window * swell * keep;
     const float sigma = s.sigma * (shape.width_taper + (1.0f - shape.width_taper) * std::sqrt(window));
     if (s.fine) return -depth * bump(best, sigma);
     // Across: the flank on the `side` of the curve is steeper than the other.
@@ -394,7 +397,7 @@ struct WrinkleArea {
             if (layout.present[i]) hairline.push_back(layout.points[i]);
         }
         std::sort(hairline.begin(), hairline.end(), [](glm::vec2 a, glm::vec2 b) { return a.x < b.x; });
-        fade = 0.15f * layout.face_unit();
+        fade = 0.12f * layout.face_unit();
         edge = 0.03f * layout.face_unit();
     }
     float hair_y(float x) const {
@@ -486,13 +489,15 @@ std::vector<float> render_height_field(const WrinkleLibrarySpec& spec, WrinkleKe
     std::vector<Stroke> strokes = resolve_strokes(spec.wrinkles[static_cast<int>(key)], spec.fold, layout);
     const WrinkleArea area(layout);
     for (Stroke& s : strokes) {
-        // Each fold fades by its centreline's distance below the hairline:
-        // the depth at the closest centreline point to the hair decides.
-        float keep = 1.0f;
-        for (const glm::vec2& p : s.polyline) keep = std::min(keep, area.centreline(p));
-        s.depth *= keep;
+        // A fold fades along its length as its centreline nears the hair,
+        // so it thins out before the hairline instead of being cut there.
+        for (size_t i = 0; i < s.polyline.size(); ++i) s.keep[i] = area.centreline(s.polyline[i]);
+        if (s.polyline.size() == 1) s.depth *= s.keep[0];
     }
-    strokes.erase(std::remove_if(strokes.begin(), strokes.end(), [](const Stroke& s) { return s.depth <= 0.0f; }),
+    strokes.erase(std::remove_if(strokes.begin(), strokes.end(),
+                                 [](const Stroke& s) {
+                                     return std::all_of(s.keep.begin(), s.keep.end(), [](float k) { return k <= 0.0f; });
+                                 }),
                   strokes.end());
     const bool detail = key == WrinkleKey::Neutral && spec.neutral_detail.amplitude > 0.0f;
     const SkinMask mask(layout);
