@@ -177,7 +177,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"PlayOddVideoSize", {"play", kTour, "--out", "OUT/a.mp4", "--size", "161x120"}, "even width"},
         BadInput{"PlaySliceBackwards", {"play", kTour, "--out", "OUT/%03d.png", "--frames", "9:3"}, "--frames '9:3': expected A < B"},
         BadInput{"PlaySlicePastTheEnd", {"play", kTour, "--out", "OUT/%03d.png", "--frames", "0:51"}, "frames 0..49"},
-        BadInput{"PlaySliceNotANumber", {"play", kTour, "--out", "OUT/%03d.png", "--frames", "a:3"}, "not a frame"},
+        BadInput{"PlaySliceNotANumber", {"play", kTour, "--out", "OUT/%03d.png", "--frames", "a:3"}, "'a' is not one"},
         BadInput{"PlayStillName", {"play", kTour, "--out", "OUT/a.png"}, "frame pattern"},
         BadInput{"PlayFolderIsAFile", {"play", kTour, "--out", "GARBAGE/a.mp4"}, "is a file, not a folder"},
         BadInput{"PlayBadBackend", {"play", kTour, "--out", "OUT/a.mp4", "--backend", "gpu"}, "--backend 'gpu'"},
