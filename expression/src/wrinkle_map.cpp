@@ -513,8 +513,6 @@ std::vector<float> render_height_field(const WrinkleLibrarySpec& spec, WrinkleKe
             const int c1 = std::min(size - 1, static_cast<int>(std::ceil(s.box_max.x * size)));
             for (int col = c0; col <= c1; ++col) out[col] += stroke_height(s, spec.fold, unit, {(col + 0.5f) * inv, y});
         }
-        for (int col = 0; col < size; ++col)
-            if (out[col] != 0.0f) out[col] *= area.pixel({(col + 0.5f) * inv, y});
         if (detail) {
             const SkinDetail& d = spec.neutral_detail;
             for (int col = 0; col < size; ++col) {
@@ -527,6 +525,9 @@ std::vector<float> render_height_field(const WrinkleLibrarySpec& spec, WrinkleKe
                 out[col] += w * n;
             }
         }
+        // Wrinkles and skin detail alike stop below the hairline.
+        for (int col = 0; col < size; ++col)
+            if (out[col] != 0.0f) out[col] *= area.pixel({(col + 0.5f) * inv, y});
     });
     return height;
 }

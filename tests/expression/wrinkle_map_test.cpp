@@ -3,6 +3,7 @@
 // features under the morph, deterministic and resolution-independent.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -308,6 +309,128 @@ TEST(WrinkleMorph, AngerGlabellaLinesFollowTheBrowsToTheSurpriseLayout) {
                               << brow_shift.x << ", " << brow_shift.y << ")";
     EXPECT_LT(fraction, 1.2f);
     EXPECT_LT(sideways, 0.1f);
+}
+
+// ---------------------------------------------------------------- fold shape
+
+// A wrinkle is a fold of skin (issue 11): a valley with raised shoulders of
+// bunched skin beside it, for grooves and for the nasolabial-type fold.
+struct ShoulderCase {
+    const char* name;
+    WrinkleProfile profile;
+    float side;
+};
+
+class FoldShoulders : public ::testing::TestWithParam<ShoulderCase> {};
+
+TEST_P(FoldShoulders, SkinRisesAboveFlatBesideTheValley) {
+    WrinkleLibrarySpec library = spec();
+    WrinkleSpec w;
+    w.name = "test fold";
+    w.profile = GetParam().profile;
+    w.side = GetParam().side;
+    w.depth = 0.02f;
+    w.width = 0.025f;
+    // A horizontal line across the cheeks, well away from the hairline.
+    w.points = {AnchoredPoint{fap::feature_point_index("3.12"), -1, 0.5f, {0.0f, -0.35f}},
+                AnchoredPoint{fap::feature_point_index("3.7"), -1, 0.5f, {0.0f, -0.35f}}};
+    library.wrinkles[static_cast<int>(WrinkleKey::Joy)] = {w};
+    const FeatureLayout& layout = key_layout(WrinkleKey::Joy);
+    constexpr int kSize = 512;
+    const std::vector<float> height = render_height_field(library, WrinkleKey::Joy, layout, kSize);
+    // Down the column through the middle of the line: the valley floor and
+    // the highest skin within the fold's reach on either side.
+    const int col = kSize / 2;
+    int floor_row = 0;
+    for (int r = 0; r < kSize; ++r)
+        if (height[r * kSize + col] < height[floor_row * kSize + col]) floor_row = r;
+    const float valley = height[floor_row * kSize + col];
+    ASSERT_LT(valley, 0.0f);
+    const int reach = static_cast<int>(std::ceil(8.0f * w.width * layout.face_unit() * kSize));
+    float above = 0.0f, below = 0.0f;
+    for (int r = 1; r <= reach; ++r) {
+        above = std::max(above, height[std::max(floor_row - r, 0) * kSize + col]);
+        below = std::max(below, height[std::min(floor_row + r, kSize - 1) * kSize + col]);
+    }
+    // Raised skin beside the valley: on both sides, a clear fraction of its depth.
+    EXPECT_GT(std::max(above, below), 0.2f * -valley) << "no shoulder beside the valley";
+    EXPECT_GT(std::min(above, below), 0.05f * -valley) << "one flank has no shoulder";
+    // And the cross-section is not mirror-symmetric (one flank is steeper).
+    EXPECT_GT(std::abs(above - below), 0.02f * -valley);
+}
+
+INSTANTIATE_TEST_SUITE_P(Profiles, FoldShoulders,
+                         ::testing::Values(ShoulderCase{"groove", WrinkleProfile::Groove, 1.0f},
+                                           ShoulderCase{"fold_left", WrinkleProfile::Fold, 1.0f},
+                                           ShoulderCase{"fold_right", WrinkleProfile::Fold, -1.0f}),
+                         [](const auto& info) { return std::string(info.param.name); });
+
+// The hairline of a layout at column x: the polyline 11.2 - 11.1 - 11.3.
+float hairline_y(const FeatureLayout& l, float x) {
+    std::vector<glm::vec2> line = {l.at("11.2"), l.at("11.1"), l.at("11.3")};
+    std::sort(line.begin(), line.end(), [](glm::vec2 a, glm::vec2 b) { return a.x < b.x; });
+    if (x <= line[0].x) return line[0].y;
+    for (int i = 0; i < 2; ++i)
+        if (x <= line[i + 1].x)
+            return line[i].y + (x - line[i].x) / (line[i + 1].x - line[i].x) * (line[i + 1].y - line[i].y);
+    return line[2].y;
+}
+
+TEST_P(EveryKey, NothingOnTheHairOrAtTheMapEdge) {
+    const WrinkleKey key = GetParam();
+    const FeatureLayout& layout = key_layout(key);
+    const std::vector<float> height = render_height_field(spec(), key, layout, 256);
+    for (int y = 0; y < 256; ++y)
+        for (int x = 0; x < 256; ++x) {
+            const float fx = (x + 0.5f) / 256, fy = (y + 0.5f) / 256;
+            const bool edge = x == 0 || y == 0 || x == 255 || y == 255;
+            if (fy <= hairline_y(layout, fx) || edge)
+                ASSERT_EQ(height[y * 256 + x], 0.0f) << wrinkle_key_name(key) << " at " << x << "," << y;
+        }
+}
+
+// The cavity in alpha: exactly 1 on flat (and raised) skin, lower in valleys.
+TEST_P(EveryKey, CavityDarkensValleysOnly) {
+    const WrinkleKey key = GetParam();
+    const NormalMap& map = key_map(key);
+    const std::vector<float> height = render_height_field(spec(), key, key_layout(key), 256);
+    float deepest = 0.0f;
+    int deepest_at = 0;
+    for (int i = 0; i < 256 * 256; ++i) {
+        if (height[i] >= 0.0f) ASSERT_EQ(map.rgba[i * 4 + 3], 255) << "at " << i % 256 << "," << i / 256;
+        if (height[i] < deepest) deepest = height[i], deepest_at = i;
+    }
+    if (key == WrinkleKey::Neutral) return;  // fine skin texture only
+    EXPECT_LT(map.rgba[deepest_at * 4 + 3], 200) << "the deepest valley should be clearly occluded";
+}
+
+TEST(WrinkleMorph, TheCavityTravelsWithTheNormals) {
+    const Face& face = testing::test_face();
+    const auto lines = lines_for_face(load_feature_lines(data_dir() + "/expression/feature_lines.json"),
+                                      present_points(face));
+    const NormalMap& map = key_map(WrinkleKey::Joy);
+    morph::Morpher morpher(256, 256, morph::PixelFormat::Rgba8,
+                           {morph::KeyMap{map.rgba.data(), to_morph(layout_segments(lines, key_layout(WrinkleKey::Joy)))}},
+                           morph::Backend::Cpu);
+    morph::MorphParams params;
+    params.normal_map = true;
+    std::vector<std::uint8_t> out(map.rgba.size());
+    morpher.morph_to_host(to_morph(layout_segments(lines, key_layout(WrinkleKey::Neutral))), {1.0f}, params,
+                          out.data());
+    // Occluded texels survive the warp, as dark as in the key, and flat
+    // skin keeps a cavity of exactly 1.
+    int darkest_in = 255, darkest_out = 255, open_flat = 0;
+    for (size_t i = 0; i < out.size(); i += 4) {
+        darkest_in = std::min<int>(darkest_in, map.rgba[i + 3]);
+        darkest_out = std::min<int>(darkest_out, out[i + 3]);
+        if (out[i] == 128 && out[i + 1] == 128 && out[i + 2] == 255) {
+            EXPECT_EQ(out[i + 3], 255);
+            ++open_flat;
+        }
+    }
+    ASSERT_LT(darkest_in, 200);
+    EXPECT_LT(darkest_out, darkest_in + 25) << "the morph lost the cavity";
+    EXPECT_GT(open_flat, 256 * 256 / 2);
 }
 
 // ---------------------------------------------------------------- sizes
