@@ -73,7 +73,7 @@ int scaled(int n, double scale, int minimum) {
 // while the slit offset is below reach / 1.5.
 double warp_falloff(double d, double reach) {
     if (d >= reach) return 0.0;
-    return 1.0 - detail::smoothstep(0.0, 1.0, d / reach);
+    return 1.0 - glm::smoothstep(0.0, 1.0, d / reach);
 }
 
 class Generator {

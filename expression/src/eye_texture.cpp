@@ -35,7 +35,7 @@ double vessels(double polar, double azimuth, double radius, double iris_angle) {
         const double across = radius * std::sin(polar) * std::abs(wrapped(azimuth - path));  // mm
         const double width = 0.05 + 0.05 * (0.5 + 0.5 * std::sin(3.1 * phase));
         const double tip = iris_angle + 0.22 + 0.35 * (0.5 + 0.5 * std::sin(phase * 0.7));
-        const double along = smoothstep(tip, tip + 0.35, polar);
+        const double along = glm::smoothstep(tip, tip + 0.35, polar);
         v = std::max(v, along * std::exp(-(across / width) * (across / width)));
     }
     return v;
@@ -53,10 +53,10 @@ std::array<double, 3> eye_colour(const FaceShape& shape, double polar, double az
     // Sclera: the painted colour, greyer and pinker towards the corners,
     // where it is exposed and its vessels show, darker round the back.
     Rgb sclera = from255(p.sclera);
-    const double corner = smoothstep(ai + 0.1, 1.25, polar) * std::pow(std::cos(azimuth), 2);
+    const double corner = glm::smoothstep(ai + 0.1, 1.25, polar) * std::pow(std::cos(azimuth), 2);
     sclera = blend(sclera, tinted(sclera, {0.95, 0.82, 0.80}), p.sclera_corner_tint * corner);
     sclera = blend(sclera, tinted(sclera, {0.80, 0.30, 0.30}), p.sclera_vessels * vessels(polar, azimuth, R, ai));
-    sclera = scaled(sclera, 1.0 - 0.25 * smoothstep(0.3 * kPi, 0.8 * kPi, polar));
+    sclera = scaled(sclera, 1.0 - 0.25 * glm::smoothstep(0.3 * kPi, 0.8 * kPi, polar));
 
     Rgb c = sclera;
     if (polar < ai + 0.03) {
@@ -68,13 +68,13 @@ std::array<double, 3> eye_colour(const FaceShape& shape, double polar, double az
         const double fibres = 0.5 + 0.22 * std::sin(61.0 * bend + 3.0 * std::sin(7.0 * bend)) +
                               0.16 * std::sin(149.0 * bend + 5.0 * t) + 0.12 * std::sin(23.0 * bend - 2.0 * t);
         Rgb iris = from255(p.iris);
-        iris = blend(iris, from255(p.iris_inner), 0.8 * (1.0 - smoothstep(0.2, 0.45, t)));
+        iris = blend(iris, from255(p.iris_inner), 0.8 * (1.0 - glm::smoothstep(0.2, 0.45, t)));
         iris = scaled(iris, 0.72 + 0.56 * fibres);
-        const double crypt = smoothstep(0.6, 0.9, std::sin(19.0 * azimuth + 1.3) * std::sin(14.0 * t + 0.4));
-        iris = scaled(iris, 1.0 - 0.25 * crypt * smoothstep(0.3, 0.45, t) * (1.0 - smoothstep(0.7, 0.8, t)));
-        iris = scaled(iris, 1.0 - 0.6 * smoothstep(0.78, 1.0, t));  // limbal ring
+        const double crypt = glm::smoothstep(0.6, 0.9, std::sin(19.0 * azimuth + 1.3) * std::sin(14.0 * t + 0.4));
+        iris = scaled(iris, 1.0 - 0.25 * crypt * glm::smoothstep(0.3, 0.45, t) * (1.0 - glm::smoothstep(0.7, 0.8, t)));
+        iris = scaled(iris, 1.0 - 0.6 * glm::smoothstep(0.78, 1.0, t));  // limbal ring
         const Rgb pupil{0.015, 0.014, 0.016};
-        iris = blend(pupil, iris, smoothstep(0.0, 0.05, t));
+        iris = blend(pupil, iris, glm::smoothstep(0.0, 0.05, t));
         c = polar > ai ? blend(iris, sclera, (polar - ai) / 0.03) : iris;
     }
 
@@ -85,10 +85,10 @@ std::array<double, 3> eye_colour(const FaceShape& shape, double polar, double az
     const double cx = p.eye_centre[0], cy = p.eye_centre[1];
     const double upper_margin = 0.5 * (shape.eye.upper(cx + x) + shape.eye.upper(cx - x)) - cy;
     const double lower_margin = 0.5 * (shape.eye.lower(cx + x) + shape.eye.lower(cx - x)) - cy;
-    const double shade = p.lid_shadow * smoothstep(upper_margin - 3.0, upper_margin + 0.5, y) +
-                         0.35 * p.lid_shadow * smoothstep(lower_margin + 1.5, lower_margin - 0.5, y);
+    const double shade = p.lid_shadow * glm::smoothstep(upper_margin - 3.0, upper_margin + 0.5, y) +
+                         0.35 * p.lid_shadow * glm::smoothstep(lower_margin + 1.5, lower_margin - 0.5, y);
     // The corners are deeper in the socket.
-    const double socket = 0.2 * smoothstep(0.55 * R, 0.9 * R, std::abs(x));
+    const double socket = 0.2 * glm::smoothstep(0.55 * R, 0.9 * R, std::abs(x));
     return scaled(c, (1.0 - std::min(shade, 0.8)) * (1.0 - socket));
 }
 

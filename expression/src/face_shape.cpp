@@ -226,7 +226,7 @@ double FaceShape::lid_blend(double x, double y, double* margin_distance) const {
         d = std::hypot(ax - cx, y - cy);
     }
     if (margin_distance) *margin_distance = d;
-    return 1.0 - smoothstep(p_.lid_blend_inner, p_.lid_blend_outer, d);
+    return 1.0 - glm::smoothstep(p_.lid_blend_inner, p_.lid_blend_outer, d);
 }
 
 double FaceShape::ear_relief(double y, double z) const {
@@ -236,8 +236,8 @@ double FaceShape::ear_relief(double y, double z) const {
     if (rho >= 1.0) return 0.0;
     const double H = p_.ear_height;
     // Attached along the front edge (v > 0), standing off the head behind.
-    const double flare = 0.3 + 0.7 * smoothstep(0.7, -0.7, v);
-    const double outline = 1.0 - smoothstep(0.8, 1.0, rho);
+    const double flare = 0.3 + 0.7 * glm::smoothstep(0.7, -0.7, v);
+    const double outline = 1.0 - glm::smoothstep(0.8, 1.0, rho);
     double h = H * flare * outline;
     h += 0.2 * H * flare * std::exp(-std::pow((rho - 0.78) / 0.08, 2));  // helix rim
     h -= 0.45 * H * flare * std::exp(-(std::pow((u + 0.15) / 0.34, 2) + std::pow((v - 0.05) / 0.3, 2)));  // concha
@@ -247,14 +247,14 @@ double FaceShape::ear_relief(double y, double z) const {
 V3 FaceShape::displace(V3 base) const {
     const V3 n = field_normal(base);
     V3 p = base;
-    const double front = smoothstep(0.05, 0.45, n.z);
+    const double front = glm::smoothstep(0.05, 0.45, n.z);
     if (front > 0.0) {
         p.z += relief(base.x, base.y) * front;
         double md = 0;
         const double b = lid_blend(base.x, base.y, &md) * front;
         if (b > 0.0) p.z = mix(p.z, lid_z(base.x, base.y, md), b);
     }
-    const double side = smoothstep(0.55, 0.85, std::abs(n.x));
+    const double side = glm::smoothstep(0.55, 0.85, std::abs(n.x));
     if (side > 0.0) {
         const double e = ear_relief(base.y, base.z) * side;
         if (e > 0.0) p = p + n * e;

@@ -8,6 +8,8 @@
 #include <array>
 #include <cmath>
 
+#include <glm/common.hpp>
+
 #include "face_params.h"
 
 namespace emoface::expression::detail {
@@ -26,10 +28,6 @@ inline V3 normalised(V3 a) {
 }
 
 inline double clamp01(double t) { return t < 0 ? 0 : (t > 1 ? 1 : t); }
-inline double smoothstep(double e0, double e1, double x) {
-    const double t = clamp01((x - e0) / (e1 - e0));
-    return t * t * (3 - 2 * t);
-}
 inline double mix(double a, double b, double t) { return a + (b - a) * t; }
 
 // The eye opening of the left eye in frontal coordinates (the right eye is

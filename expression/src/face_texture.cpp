@@ -87,8 +87,8 @@ double Painter::brow_density(double x, double y) const {
     const double half = 0.5 * th;
     const double q = best / half;
     if (q > 1.3) return 0.0;
-    double m_edge = 1.0 - smoothstep(0.55, 1.15, q);
-    m_edge *= 0.55 + 0.45 * smoothstep(0.0, 0.22, best_t);  // sparse at the inner end
+    double m_edge = 1.0 - glm::smoothstep(0.55, 1.15, q);
+    m_edge *= 0.55 + 0.45 * glm::smoothstep(0.0, 0.22, best_t);  // sparse at the inner end
     (void)best_sd;
     // Hair strands: noise stretched along the brow (mostly horizontal).
     const double strands = noise(x * 0.9, y * 3.2, 7.0) * 0.6 + noise(x * 2.3, y * 6.0, 3.0) * 0.4;
@@ -107,15 +107,15 @@ bool Painter::hair(V3 q, double* amount) const {
     const double ear_front = p_.ear_centre_yz[1] + p_.ear_radii_yz[1] + 3.0;
     const double ear_back = p_.ear_centre_yz[1] - p_.ear_radii_yz[1] - 3.0;
     double side_line;
-    if (q.z > ear_front) side_line = mix(ear_top, p_.sideburn_bottom_y, smoothstep(ear_front, ear_front + 5.0, q.z));
+    if (q.z > ear_front) side_line = mix(ear_top, p_.sideburn_bottom_y, glm::smoothstep(ear_front, ear_front + 5.0, q.z));
     else if (q.z > ear_back) side_line = ear_top;
-    else side_line = mix(ear_top, p_.hair_back_bottom_y, smoothstep(ear_back, ear_back - 35.0, q.z));
-    const double line = mix(side_line, front_line, smoothstep(p_.sideburn_z - 6.0, p_.sideburn_z + 6.0, q.z));
+    else side_line = mix(ear_top, p_.hair_back_bottom_y, glm::smoothstep(ear_back, ear_back - 35.0, q.z));
+    const double line = mix(side_line, front_line, glm::smoothstep(p_.sideburn_z - 6.0, p_.sideburn_z + 6.0, q.z));
     double edge = q.y - line;
     // Leave the ears bare.
     if (ax > 55 && s_.ear_relief(q.y, q.z) > 0.3) edge = std::min(edge, -2.0);
     edge += (noise(q.x * 0.4, q.y * 0.4, q.z * 0.4) - 0.5) * 3.0;
-    *amount = smoothstep(-1.0, 2.5, edge);
+    *amount = glm::smoothstep(-1.0, 2.5, edge);
     return *amount > 0.0;
 }
 
@@ -151,14 +151,14 @@ Rgb Painter::skin(V3 q) const {
         const double chin = field(q.x, q.y, 0.0, -96.0, 14.0, 9.0);
         c = redden(c, blotch * (0.55 * cheek + 0.5 * nose + 0.22 * chin));
         // Forehead: a shade darker and more yellow.
-        const double forehead = smoothstep(18.0, 45.0, q.y);
+        const double forehead = glm::smoothstep(18.0, 45.0, q.y);
         c = blend(c, c * Rgb{0.97, 0.955, 0.92}, 0.8 * forehead);
 
         // Beard zone (shaved): a bluish-grey cast from the stubble under the
         // skin, over the upper lip, chin, jaw and lower cheeks, below a line
         // from the sideburn to the mouth corner, fading on the neck.
         const double cheek_line = ax < 28.0 ? -46.0 : mix(-46.0, -14.0, std::min((ax - 28.0) / 34.0, 1.0));
-        const double beard = smoothstep(2.0, -10.0, q.y - cheek_line) * smoothstep(-150.0, -118.0, q.y) *
+        const double beard = glm::smoothstep(2.0, -10.0, q.y - cheek_line) * glm::smoothstep(-150.0, -118.0, q.y) *
                              (0.8 + 0.4 * noise(q.x * 1.7, q.y * 1.7, q.z * 1.7));
         c = blend(c, c * Rgb{0.84, 0.88, 0.97}, 0.38 * beard);
 
@@ -167,9 +167,9 @@ Rgb Painter::skin(V3 q) const {
         if (ax < hw + 2.0 && q.z > 60.0) {
             const double up = s_.upper_border(q.x), lo = s_.lower_border(q.x);
             const double inside = std::min({up - q.y, q.y - lo, (hw - ax) * 0.6});
-            const double m = smoothstep(-0.3, 0.35, inside);
+            const double m = glm::smoothstep(-0.3, 0.35, inside);
             if (m > 0) {
-                const double crease = smoothstep(0.0, 2.0, std::abs(q.y - s_.mouth_line(q.x)));
+                const double crease = glm::smoothstep(0.0, 2.0, std::abs(q.y - s_.mouth_line(q.x)));
                 Rgb lips = from255(p_.lips) * (0.78 + 0.22 * crease) *
                            (0.94 + 0.12 * noise(q.x * 2.5, q.y * 0.6, 1.0));
                 c = blend(c, lips, m);
@@ -184,20 +184,20 @@ Rgb Painter::skin(V3 q) const {
             const double lo = within ? e.lower(ax) : (ax < e.x_in ? e.y_in : e.y_out);
             const double dy_up = q.y - up, dy_lo = lo - q.y;
             if (dy_up > -0.3) {
-                const double lid = (1.0 - smoothstep(0.0, 9.0, dy_up)) * (within ? 1.0 : 0.5);
+                const double lid = (1.0 - glm::smoothstep(0.0, 9.0, dy_up)) * (within ? 1.0 : 0.5);
                 c = blend(c, c * Rgb{0.86, 0.78, 0.8}, 0.5 * lid);
                 const double reach = 0.6 + 0.9 * s;  // lashes thicken towards the outer corner
-                const double lash = (1.0 - smoothstep(0.15, reach, dy_up)) * (within ? 1.0 : smoothstep(3.0, 0.0, std::min(std::abs(ax - e.x_in), std::abs(ax - e.x_out))));
+                const double lash = (1.0 - glm::smoothstep(0.15, reach, dy_up)) * (within ? 1.0 : glm::smoothstep(3.0, 0.0, std::min(std::abs(ax - e.x_in), std::abs(ax - e.x_out))));
                 c = blend(c, Rgb{0.09, 0.06, 0.05}, 0.92 * lash);
             }
             if (dy_lo > -0.3 && within) {
-                const double lash = 1.0 - smoothstep(0.05, 0.55, dy_lo);
+                const double lash = 1.0 - glm::smoothstep(0.05, 0.55, dy_lo);
                 c = blend(c, Rgb{0.25, 0.15, 0.13}, 0.55 * lash);
-                const double shadow = 1.0 - smoothstep(0.0, 6.0, dy_lo);
+                const double shadow = 1.0 - glm::smoothstep(0.0, 6.0, dy_lo);
                 c = blend(c, c * Rgb{0.88, 0.8, 0.82}, 0.35 * shadow);
             }
             // Inner corner (caruncle).
-            const double car = 1.0 - smoothstep(0.6, 2.2, std::hypot(ax - e.x_in - 0.6, q.y - e.y_in));
+            const double car = 1.0 - glm::smoothstep(0.6, 2.2, std::hypot(ax - e.x_in - 0.6, q.y - e.y_in));
             c = blend(c, Rgb{0.78, 0.45, 0.45}, 0.7 * car);
         }
         // Brows.
@@ -207,7 +207,7 @@ Rgb Painter::skin(V3 q) const {
         }
         // Nostrils.
         const double n = s_.nostril_amount(q.x, q.y);
-        if (n > 0) c = blend(c, Rgb{0.25, 0.12, 0.11}, smoothstep(0.05, 0.5, n));
+        if (n > 0) c = blend(c, Rgb{0.25, 0.12, 0.11}, glm::smoothstep(0.05, 0.5, n));
     }
     // Ears: thin, well perfused, redder than the face beside them.
     if (ax > 55.0 && s_.ear_relief(q.y, q.z) > 0.0)
@@ -245,9 +245,9 @@ Rgb Painter::tile(double u, double v) const {
             const double bounds[] = {0.0, 4.3, 10.6, 17.8, 24.6, 31.4, 41.0};
             double gap = 1e9;
             for (double b : bounds) gap = std::min(gap, std::abs(s - b * (upper ? 1.0 : 0.8)));
-            Rgb teeth = from255(p_.teeth) * (1.0 - 0.45 * (1.0 - smoothstep(0.15, 0.5, gap)));
+            Rgb teeth = from255(p_.teeth) * (1.0 - 0.45 * (1.0 - glm::smoothstep(0.15, 0.5, gap)));
             const double edge = std::min(std::abs(c - 1.0), std::abs(c - 2.0));
-            teeth = blend(teeth, teeth * Rgb{0.85, 0.87, 0.92}, 1.0 - smoothstep(0.0, 0.25, edge));
+            teeth = blend(teeth, teeth * Rgb{0.85, 0.87, 0.92}, 1.0 - glm::smoothstep(0.0, 0.25, edge));
             const double gum = c < 0.25 || c > 2.75 ? 1.0 : 0.0;
             return blend(teeth, Rgb{0.72, 0.36, 0.36}, gum);
         }

@@ -5,6 +5,8 @@
 #include <map>
 #include <string_view>
 
+#include <glm/glm.hpp>
+
 #include "emoface/common/constants.h"
 #include "emoface/common/error.h"
 #include "emoface/fap/feature_points.h"
@@ -14,34 +16,27 @@
 namespace emoface::expression {
 namespace {
 
-using V = std::array<double, 3>;
+using V = glm::dvec3;
 
-V sub(V a, V b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-V add(V a, V b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
-V scale(V a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
 V to_v(const TriMesh::Point& p) { return {p[0], p[1], p[2]}; }
+V to_v(const std::array<double, 3>& p) { return {p[0], p[1], p[2]}; }
+std::array<double, 3> to_array(const V& v) { return {v.x, v.y, v.z}; }
 
-double smoothstep(double e0, double e1, double x) {
-    const double t = std::clamp((x - e0) / (e1 - e0), 0.0, 1.0);
-    return t * t * (3 - 2 * t);
-}
 double raised_cosine(double t) { return t >= 1.0 ? 0.0 : 0.5 * (1.0 + std::cos(kPi * t)); }
 
-// Row-major 3x3 rotation matrices.
-using M3 = std::array<double, 9>;
-M3 rot_x(double a) { return {1, 0, 0, 0, std::cos(a), -std::sin(a), 0, std::sin(a), std::cos(a)}; }
-M3 rot_y(double a) { return {std::cos(a), 0, std::sin(a), 0, 1, 0, -std::sin(a), 0, std::cos(a)}; }
-M3 rot_z(double a) { return {std::cos(a), -std::sin(a), 0, std::sin(a), std::cos(a), 0, 0, 0, 1}; }
-M3 mul(const M3& a, const M3& b) {
-    M3 r{};
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-            for (int k = 0; k < 3; ++k) r[i * 3 + j] += a[i * 3 + k] * b[k * 3 + j];
-    return r;
+// Rotations about the axes (glm::dmat3 is column-major: each group of three
+// is a column).
+glm::dmat3 rot_x(double a) {
+    const double c = std::cos(a), s = std::sin(a);
+    return {1, 0, 0, 0, c, s, 0, -s, c};
 }
-V mat_apply(const M3& m, V v) {
-    return {m[0] * v[0] + m[1] * v[1] + m[2] * v[2], m[3] * v[0] + m[4] * v[1] + m[5] * v[2],
-            m[6] * v[0] + m[7] * v[1] + m[8] * v[2]};
+glm::dmat3 rot_y(double a) {
+    const double c = std::cos(a), s = std::sin(a);
+    return {c, 0, -s, 0, 1, 0, s, 0, c};
+}
+glm::dmat3 rot_z(double a) {
+    const double c = std::cos(a), s = std::sin(a);
+    return {c, s, 0, -s, c, 0, 0, 0, 1};
 }
 
 bool is_point_fap(int f) {
@@ -206,8 +201,7 @@ void FaceRig::build_point_field(const Face& face, double radius_scale) {
         for (std::size_t i = 0; i < entries.size(); ++i) {
             const int q = system_fps_[i];
             if (i == j || !driven[q] || fap::feature_points()[q].group != group) continue;
-            const V d = sub(fps_[k].position, fps_[q].position);
-            nearest = std::min(nearest, std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]));
+            nearest = std::min(nearest, glm::length(to_v(fps_[k].position) - to_v(fps_[q].position)));
         }
         if (nearest < 1e29) entries[j].radius = std::clamp(1.3 * nearest, entries[j].radius, 2.0 * entries[j].radius);
     }
@@ -225,7 +219,7 @@ void FaceRig::build_point_field(const Face& face, double radius_scale) {
     // enough that large FAPs do not fold the skin). Weights form a convex
     // combination, so nothing overshoots.
     constexpr double kBackground = 0.15;
-    auto falloff = [](double t) { return 1.0 - smoothstep(0.2, 1.0, t); };
+    auto falloff = [](double t) { return 1.0 - glm::smoothstep(0.2, 1.0, t); };
     detail::GeodesicGraph graph(face.mesh, face.welded);
     std::vector<std::vector<std::pair<int, double>>> reach(n);  // (entry, distance)
     for (std::size_t j = 0; j < entries.size(); ++j)
@@ -306,10 +300,10 @@ void FaceRig::build_jaw(const Face& face) {
             return;
         }
     has_jaw_ = true;
-    jaw_pivot_ = face.jaw_pivot;
+    jaw_pivot_ = to_v(face.jaw_pivot);
     const double es0 = fapu_.es * 1024.0;
-    const V p22 = fps_[idx("2.2")].position, p23 = fps_[idx("2.3")].position;
-    const V pl = fps_[idx("2.4")].position, pr = fps_[idx("2.5")].position;
+    const V p22 = to_v(fps_[idx("2.2")].position), p23 = to_v(fps_[idx("2.3")].position);
+    const V pl = to_v(fps_[idx("2.4")].position), pr = to_v(fps_[idx("2.5")].position);
     const double chin_y = fps_[idx("2.1")].position[1];
     const double mx = 0.5 * (pl[0] + pr[0]), half_width = 0.5 * std::abs(pl[0] - pr[0]);
     const double y_mid = 0.5 * (p22[1] + p23[1]), y_corner = 0.5 * (pl[1] + pr[1]);
@@ -341,16 +335,16 @@ void FaceRig::build_jaw(const Face& face) {
             const double t = std::clamp((z_corner - z) / std::max(z_corner - P[2], 1e-9), 0.0, 1.0);
             line = y_corner + (P[1] - y_corner) * t;
         }
-        double w = smoothstep(delta, -delta, y - line);
+        double w = glm::smoothstep(delta, -delta, y - line);
         if (to_upper[v] < 1e29 || to_lower[v] < 1e29) {
-            const double lip = 1.0 - smoothstep(0.6 * half_width, 1.1 * half_width, std::abs(x - mx));
+            const double lip = 1.0 - glm::smoothstep(0.6 * half_width, 1.1 * half_width, std::abs(x - mx));
             w = to_lower[v] < to_upper[v] ? std::max(w, lip) : std::min(w, 1.0 - lip);
         }
         // The neck below the chin and the head behind the jaw joint stay; the
         // fades are long so a wide-open jaw stretches the skin instead of
         // folding it.
-        w *= smoothstep(chin_y - 0.8 * es0, chin_y - 0.08 * es0, y);
-        w *= smoothstep(P[2] - 0.1 * es0, P[2] + 0.6 * es0, z);
+        w *= glm::smoothstep(chin_y - 0.8 * es0, chin_y - 0.08 * es0, y);
+        w *= glm::smoothstep(P[2] - 0.1 * es0, P[2] + 0.6 * es0, z);
         jaw_weight_[v] = static_cast<float>(w);
     }
     for (int v = 0; v < n; ++v)
@@ -363,20 +357,19 @@ void FaceRig::build_eyes(const Face& face) {
         EyeState e;
         e.first = eb.vertices.first;
         e.count = eb.vertices.count;
-        e.centre = eb.centre;
+        e.centre = to_v(eb.centre);
         e.radius = eb.radius;
         e.iris_angle = eb.iris_angle;
         e.pupil_angle = eb.pupil_angle;
         for (int v = e.first; v < e.first + e.count; ++v) {
-            const V d = sub(to_v(neutral_[v]), e.centre);
-            const double r = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            const V d = to_v(neutral_[v]) - e.centre;
+            const double r = glm::length(d);
             e.polar.push_back(static_cast<float>(r > 0 ? std::acos(std::clamp(d[2] / r, -1.0, 1.0)) : 0.0));
             e.azimuth.push_back(static_cast<float>(std::atan2(d[1], d[0])));
         }
         for (const auto* margin : {&eb.upper_margin, &eb.lower_margin})
             for (int v : *margin) {
-                const V d = sub(to_v(neutral_[v]), e.centre);
-                clearance = std::min(clearance, std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) - e.radius);
+                clearance = std::min(clearance, glm::length(to_v(neutral_[v]) - e.centre) - e.radius);
             }
         eyes_.push_back(std::move(e));
     }
@@ -415,8 +408,8 @@ void FaceRig::build_eyes(const Face& face) {
     for (int v = 0; v < static_cast<int>(neutral_.size()); ++v) {
         if (parts_[v] != VertexPart::Skin) continue;
         for (std::size_t e = 0; e < eyes_.size(); ++e) {
-            const V d = sub(to_v(neutral_[v]), eyes_[e].centre);
-            const double r = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            const V d = to_v(neutral_[v]) - eyes_[e].centre;
+            const double r = glm::length(d);
             if (d[2] <= 0 || r > eyes_[e].radius * 1.8) continue;
             const double min_r = eyes_[e].radius + std::min(std::max(r - eyes_[e].radius, 0.0), clearance);
             lid_vertices_.push_back(
@@ -426,12 +419,12 @@ void FaceRig::build_eyes(const Face& face) {
 }
 
 void FaceRig::build_head(const Face& face) {
-    head_pivot_ = face.head_pivot;
+    head_pivot_ = to_v(face.head_pivot);
     const double es0 = fapu_.es * 1024.0;
     head_weight_.assign(neutral_.size(), 1.0f);
     for (std::size_t v = 0; v < neutral_.size(); ++v)
         if (parts_[v] == VertexPart::Skin)
-            head_weight_[v] = static_cast<float>(smoothstep(head_pivot_[1] - 0.9 * es0, head_pivot_[1], neutral_[v][1]));
+            head_weight_[v] = static_cast<float>(glm::smoothstep(head_pivot_[1] - 0.9 * es0, head_pivot_[1], double(neutral_[v][1])));
 }
 
 void FaceRig::point_displacements(const FapValues& faps, std::array<std::array<double, 3>, fap::kFeaturePointCount>& d) const {
@@ -528,20 +521,20 @@ void FaceRig::deform(const FapValues& faps, DeformedFace& out) const {
     // thrust (14) and shift (15).
     const double open = faps[2], thrust = faps[13], shift = faps[14];
     if (has_jaw_ && (open != 0 || thrust != 0 || shift != 0)) {
-        const V chin = sub(fps_[fap::feature_point_index("2.1")].position, jaw_pivot_);
+        const V chin = to_v(fps_[fap::feature_point_index("2.1")].position) - jaw_pivot_;
         const double drop = open * fapu_.mns;
         const double a = std::hypot(chin[1], chin[2]);
         const double phi0 = std::atan2(chin[2], chin[1]);
         const double angle = a > 0 ? std::acos(std::clamp((chin[1] - drop) / a, -1.0, 1.0)) - phi0 : 0.0;
-        const M3 r = rot_x(angle);
+        const glm::dmat3 r = rot_x(angle);
         const auto& i14 = fap::fap_info(14);
         const auto& i15 = fap::fap_info(15);
-        V t{0, 0, 0};
+        V t(0.0);
         for (int c = 0; c < 3; ++c)
             t[c] = thrust * fapu_.of(i14.unit) * i14.direction[c] + shift * fapu_.of(i15.unit) * i15.direction[c];
         for (int v : jaw_vertices_) {
             const V p = to_v(pos[v]);
-            const V moved = add(add(mat_apply(r, sub(p, jaw_pivot_)), jaw_pivot_), t);
+            const V moved = r * (p - jaw_pivot_) + jaw_pivot_ + t;
             const double w = jaw_weight_[v];
             pos[v] = TriMesh::Point(static_cast<float>(p[0] + w * (moved[0] - p[0])),
                                     static_cast<float>(p[1] + w * (moved[1] - p[1])),
@@ -555,17 +548,17 @@ void FaceRig::deform(const FapValues& faps, DeformedFace& out) const {
         const double yaw = faps[left ? 22 : 23], pitch = faps[left ? 24 : 25];
         const double thrust_e = faps[left ? 26 : 27], dilate = faps[left ? 28 : 29];
         if (yaw == 0 && pitch == 0 && thrust_e == 0 && dilate == 0) continue;
-        const M3 r = mul(rot_y(yaw * fapu_.au), rot_x(pitch * fapu_.au));
-        const V t{0, 0, thrust_e * fapu_.es};
+        const glm::dmat3 r = rot_y(yaw * fapu_.au) * rot_x(pitch * fapu_.au);
+        const V t(0.0, 0.0, thrust_e * fapu_.es);
         const double sin_p = std::sin(e.pupil_angle) * e.radius;
         const double iris_r = std::sin(e.iris_angle) * e.radius;
         const double pupil_r = std::clamp(sin_p + 0.5 * dilate * fapu_.irisd, 0.12 * iris_r, 0.95 * iris_r);
         const double new_pupil = std::asin(std::min(pupil_r / e.radius, 1.0));
         for (int k = 0; k < e.count; ++k) {
             const int v = e.first + k;
-            V d = sub(to_v(neutral_[v]), e.centre);
+            V d = to_v(neutral_[v]) - e.centre;
             if (dilate != 0 && e.polar[k] < e.iris_angle) {
-                const double r = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+                const double r = glm::length(d);
                 const double a = e.polar[k];
                 const double na = a < e.pupil_angle
                                       ? a * new_pupil / e.pupil_angle
@@ -574,7 +567,7 @@ void FaceRig::deform(const FapValues& faps, DeformedFace& out) const {
                 d = {r * std::sin(na) * std::cos(e.azimuth[k]), r * std::sin(na) * std::sin(e.azimuth[k]),
                      r * std::cos(na)};
             }
-            const V p = add(add(mat_apply(r, d), e.centre), t);
+            const V p = r * d + e.centre + t;
             pos[v] = TriMesh::Point(static_cast<float>(p[0]), static_cast<float>(p[1]), static_cast<float>(p[2]));
         }
     }
@@ -582,15 +575,15 @@ void FaceRig::deform(const FapValues& faps, DeformedFace& out) const {
     // Head: pitch (48, front down), yaw (49, front to the face's left), roll
     // (50, top to the face's right), about 7.1.
     const double hp = faps[47], hy = faps[48], hr = faps[49];
-    M3 head{1, 0, 0, 0, 1, 0, 0, 0, 1};
+    glm::dmat3 head(1.0);
     const bool turn = hp != 0 || hy != 0 || hr != 0;
     if (turn) {
-        head = mul(rot_y(hy * fapu_.au), mul(rot_x(hp * fapu_.au), rot_z(hr * fapu_.au)));
+        head = rot_y(hy * fapu_.au) * (rot_x(hp * fapu_.au) * rot_z(hr * fapu_.au));
         for (int v = 0; v < n; ++v) {
             const double w = head_weight_[v];
             if (w <= 0) continue;
             const V p = to_v(pos[v]);
-            const V moved = add(mat_apply(head, sub(p, head_pivot_)), head_pivot_);
+            const V moved = head * (p - head_pivot_) + head_pivot_;
             pos[v] = TriMesh::Point(static_cast<float>(p[0] + w * (moved[0] - p[0])),
                                     static_cast<float>(p[1] + w * (moved[1] - p[1])),
                                     static_cast<float>(p[2] + w * (moved[2] - p[2])));
@@ -602,12 +595,13 @@ void FaceRig::deform(const FapValues& faps, DeformedFace& out) const {
         if (!fp.present) {
             out.feature_points[k] = {0, 0, 0};
         } else if (fp.vertex >= 0) {
-            out.feature_points[k] = to_v(pos[fp.vertex]);
+            out.feature_points[k] = to_array(to_v(pos[fp.vertex]));
         } else if (turn) {
             // Free points (7.1, 11.5) turn with the head where the skin would.
-            const double w = smoothstep(head_pivot_[1] - 0.9 * fapu_.es * 1024.0, head_pivot_[1], fp.position[1]);
-            const V moved = add(mat_apply(head, sub(fp.position, head_pivot_)), head_pivot_);
-            out.feature_points[k] = add(fp.position, scale(sub(moved, fp.position), w));
+            const double w = glm::smoothstep(head_pivot_[1] - 0.9 * fapu_.es * 1024.0, head_pivot_[1], fp.position[1]);
+            const V p = to_v(fp.position);
+            const V moved = head * (p - head_pivot_) + head_pivot_;
+            out.feature_points[k] = to_array(p + (moved - p) * w);
         } else {
             out.feature_points[k] = fp.position;
         }

@@ -93,7 +93,7 @@ struct Face {
     // One VertexPart per mesh vertex (uint8 of VertexPart).
     std::vector<VertexPart> parts;
     // Indexed like fap::feature_points() (0 = "2.1" ... 83 = "11.6").
-    std::array<FeaturePointLocation, 84> feature_points{};
+    std::array<FeaturePointLocation, kFeatureCount> feature_points{};
     fap::Fapu fapu{};
     // [0] = left eye (x > 0), [1] = right eye, when the face has eyeballs.
     std::vector<Eyeball> eyeballs;

@@ -28,6 +28,8 @@
 #include <string>
 #include <vector>
 
+#include <glm/vec3.hpp>
+
 #include "emoface/expression/face.h"
 #include "emoface/expression/fap_values.h"
 #include "emoface/fap/fap_table.h"
@@ -85,7 +87,7 @@ private:
     };
     struct EyeState {
         int first = 0, count = 0;
-        std::array<double, 3> centre{};
+        glm::dvec3 centre{0.0};
         double radius = 0, iris_angle = 0, pupil_angle = 0;
         std::vector<float> polar, azimuth;  // per eyeball vertex, neutral
     };
@@ -125,7 +127,7 @@ private:
     // Jaw.
     std::vector<float> jaw_weight_;
     std::vector<int> jaw_vertices_;
-    std::array<double, 3> jaw_pivot_{};
+    glm::dvec3 jaw_pivot_{0.0};
     bool has_jaw_ = false;
 
     // Eyes and eyelids.
@@ -143,7 +145,7 @@ private:
     std::vector<LashVertex> lash_vertices_;
 
     // Head.
-    std::array<double, 3> head_pivot_{};
+    glm::dvec3 head_pivot_{0.0};
     std::vector<float> head_weight_;
 
     std::array<std::string, fap::kFapCount> no_effect_{};
