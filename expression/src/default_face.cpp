@@ -30,9 +30,6 @@ namespace {
 
 using detail::FaceParams;
 using detail::FaceShape;
-using detail::V3;
-using detail::length;
-constexpr auto length_of = [](V3 v) { return detail::length(v); };
 
 constexpr double kDeg = kPi / 180.0;
 
@@ -42,11 +39,11 @@ struct Row {
     double angle_front = 0, angle_back = 0;  // radians
 
     static double front_weight(double theta) { return 0.5 * (1.0 + std::cos(theta)); }
-    V3 origin(double theta) const { return {0.0, origin_y, detail::mix(z_back, z_front, front_weight(theta))}; }
+    glm::dvec3 origin(double theta) const { return {0.0, origin_y, detail::mix(z_back, z_front, front_weight(theta))}; }
     double angle(double theta) const { return detail::mix(angle_back, angle_front, front_weight(theta)); }
 };
 
-V3 ray_dir(double theta, double phi) {
+glm::dvec3 ray_dir(double theta, double phi) {
     return {std::sin(theta) * std::cos(phi), std::sin(phi), std::cos(theta) * std::cos(phi)};
 }
 
@@ -84,9 +81,9 @@ public:
     Face build(int texture_size);
 
 private:
-    V3 base_point(double theta, const Row& row, double dphi) const {
-        const V3 o = row.origin(theta);
-        const V3 d = ray_dir(theta, row.angle(theta) + dphi);
+    glm::dvec3 base_point(double theta, const Row& row, double dphi) const {
+        const glm::dvec3 o = row.origin(theta);
+        const glm::dvec3 d = ray_dir(theta, row.angle(theta) + dphi);
         return o + d * shape_.cast(o, d);
     }
     // The elevation offset that puts the face-row vertex of column theta
@@ -95,11 +92,11 @@ private:
     double solve_offset(double theta, const Row& row, Target target) const {
         double dphi = 0.0;
         for (int it = 0; it < 12; ++it) {
-            const V3 p = base_point(theta, row, dphi);
+            const glm::dvec3 p = base_point(theta, row, dphi);
             const double err = p.y - target(p.x);
             if (std::abs(err) < 1e-6) break;
             const double h = 1e-4;
-            const V3 q = base_point(theta, row, dphi + h);
+            const glm::dvec3 q = base_point(theta, row, dphi + h);
             const double derr = ((q.y - target(q.x)) - err) / h;
             if (std::abs(derr) < 1e-9) break;
             dphi -= err / derr;
@@ -127,7 +124,7 @@ private:
     void place_feature_points(Face& face);
 
     int grid(int i, int j) const { return j * (ncols_ + 1) + i; }
-    TriMesh::VertexHandle add_vertex(Face& face, V3 p, double u, double v, VertexPart part) {
+    TriMesh::VertexHandle add_vertex(Face& face, glm::dvec3 p, double u, double v, VertexPart part) {
         auto vh = face.mesh.add_vertex(TriMesh::Point(static_cast<float>(p.x), static_cast<float>(p.y),
                                                       static_cast<float>(p.z)));
         face.mesh.set_texcoord2D(vh, TriMesh::TexCoord2D(static_cast<float>(u), static_cast<float>(v)));
@@ -135,7 +132,7 @@ private:
         return vh;
     }
     // Adds a triangle wound so its normal points along `outward`.
-    void add_oriented(Face& face, int a, int b, int c, V3 outward) {
+    void add_oriented(Face& face, int a, int b, int c, glm::dvec3 outward) {
         const auto pa = face.mesh.point(TriMesh::VertexHandle(a));
         const auto pb = face.mesh.point(TriMesh::VertexHandle(b));
         const auto pc = face.mesh.point(TriMesh::VertexHandle(c));
@@ -166,7 +163,7 @@ private:
     std::vector<int> eye_lower_copy_, mouth_lower_copy_;  // per column, -1 if none
     int pole_ = -1;
     int rejected_faces_ = 0;
-    std::vector<V3> base_;  // base (pre-relief) points of the skin vertices
+    std::vector<glm::dvec3> base_;  // base (pre-relief) points of the skin vertices
     // vertex ranges of the mouth interior pieces
     int tongue_first_ = 0, tongue_count_ = 0, tongue_rings_ = 0, tongue_segments_ = 0;
     int upper_teeth_first_ = 0, lower_teeth_first_ = 0, teeth_sections_ = 0;
@@ -196,12 +193,12 @@ std::vector<Row> Generator::resample(const std::vector<detail::RowKey>& keys) co
     for (std::size_t k = 0; k + 1 < keys.size(); ++k) {
         const double spacing = (keys[k].spacing > 0 ? keys[k].spacing : p_.row_spacing) / scale_;
         std::vector<double> length(kFine + 1, 0.0);
-        V3 prev_f{}, prev_b{};
+        glm::dvec3 prev_f{0.0}, prev_b{0.0};
         for (int s = 0; s <= kFine; ++s) {
             const Row row = to_row(lerp_key(keys[k], keys[k + 1], static_cast<double>(s) / kFine));
-            const V3 f = shape_.displace(base_point(0.0, row, 0.0));
-            const V3 b = base_point(kPi, row, 0.0);
-            if (s > 0) length[s] = length[s - 1] + std::max(length_of(f - prev_f), 0.5 * length_of(b - prev_b));
+            const glm::dvec3 f = shape_.displace(base_point(0.0, row, 0.0));
+            const glm::dvec3 b = base_point(kPi, row, 0.0);
+            if (s > 0) length[s] = length[s - 1] + std::max(glm::length(f - prev_f), 0.5 * glm::length(b - prev_b));
             prev_f = f;
             prev_b = b;
         }
@@ -375,7 +372,7 @@ void Generator::build_skin(Face& face) {
 
     for (int j = 0; j < nrows; ++j) {
         for (int i = 0; i <= ncols_; ++i) {
-            const V3 b = base_point(theta_[i], rows_[j], offset(i, j, false));
+            const glm::dvec3 b = base_point(theta_[i], rows_[j], offset(i, j, false));
             base_.push_back(b);
             add_vertex(face, shape_.displace(b), static_cast<double>(i) / ncols_, v_of(j), VertexPart::Skin);
         }
@@ -383,7 +380,7 @@ void Generator::build_skin(Face& face) {
     auto mirror = [&](int i) { return 2 * centre_col_ - i; };
     for (int i = eye_in_col_ + 1; i < eye_out_col_; ++i) {
         for (int c : {i, mirror(i)}) {
-            const V3 b = base_point(theta_[c], rows_[eye_row_], offset(c, eye_row_, true));
+            const glm::dvec3 b = base_point(theta_[c], rows_[eye_row_], offset(c, eye_row_, true));
             base_.push_back(b);
             eye_lower_copy_[c] = add_vertex(face, shape_.displace(b), static_cast<double>(c) / ncols_, v_of(eye_row_),
                                             VertexPart::Skin)
@@ -391,14 +388,14 @@ void Generator::build_skin(Face& face) {
         }
     }
     for (int i = mirror(mouth_corner_col_) + 1; i < mouth_corner_col_; ++i) {
-        const V3 b = base_[grid(i, mouth_row_)];
+        const glm::dvec3 b = base_[grid(i, mouth_row_)];
         base_.push_back(b);
         mouth_lower_copy_[i] =
             add_vertex(face, shape_.displace(b), static_cast<double>(i) / ncols_, v_of(mouth_row_), VertexPart::Skin).idx();
     }
     {
-        const V3 o = rows_.back().origin(0.0);
-        const V3 b = o + V3{0, 1, 0} * shape_.cast(o, {0, 1, 0});
+        const glm::dvec3 o = rows_.back().origin(0.0);
+        const glm::dvec3 b = o + glm::dvec3{0, 1, 0} * shape_.cast(o, {0, 1, 0});
         base_.push_back(b);
         pole_ = add_vertex(face, shape_.displace(b), 0.5, 0.999, VertexPart::Skin).idx();
     }
@@ -429,7 +426,7 @@ void Generator::build_skin(Face& face) {
 
 void Generator::build_eyeball(Face& face, int side) {
     const double sx = side == 0 ? 1.0 : -1.0;
-    const V3 c{p_.eye_centre[0] * sx, p_.eye_centre[1], p_.eye_centre[2]};
+    const glm::dvec3 c{p_.eye_centre[0] * sx, p_.eye_centre[1], p_.eye_centre[2]};
     const double R = p_.eye_radius;
     const int rings = p_.eyeball_rings, segs = p_.eyeball_segments;
     const double iris = std::asin(p_.iris_radius / R);
@@ -452,7 +449,8 @@ void Generator::build_eyeball(Face& face, int side) {
         u = detail::tile_u0(detail::Tile::Eye) + detail::kTile * (0.5 + r * std::cos(b));
         v = detail::kTile * (0.5 + r * std::sin(b));
     };
-    const int front = add_vertex(face, c + V3{0, 0, R}, detail::tile_u0(detail::Tile::Eye) + 0.5 * detail::kTile,
+    const int front = add_vertex(face, c + glm::dvec3{0, 0, R},
+                                 detail::tile_u0(detail::Tile::Eye) + 0.5 * detail::kTile,
                                  0.5 * detail::kTile, part)
                           .idx();
     const int first_ring = face.vertex_count();
@@ -461,17 +459,18 @@ void Generator::build_eyeball(Face& face, int side) {
             const double b = 2 * kPi * s / segs;
             double u, v;
             uv(a, b, u, v);
-            add_vertex(face, c + V3{std::sin(a) * std::cos(b), std::sin(a) * std::sin(b), std::cos(a)} * R, u, v, part);
+            const glm::dvec3 dir{std::sin(a) * std::cos(b), std::sin(a) * std::sin(b), std::cos(a)};
+            add_vertex(face, c + dir * R, u, v, part);
         }
     }
     double bu, bv;
     uv(kPi, 0, bu, bv);
-    const int back = add_vertex(face, c + V3{0, 0, -R}, bu, bv, part).idx();
+    const int back = add_vertex(face, c + glm::dvec3{0, 0, -R}, bu, bv, part).idx();
     eb.vertices.count = face.vertex_count() - eb.vertices.first;
     auto ring = [&](int k, int s) { return first_ring + k * segs + (s % segs); };
     auto out = [&](int a) {
         const auto q = face.mesh.point(TriMesh::VertexHandle(a));
-        return V3{q[0] - c.x, q[1] - c.y, q[2] - c.z};
+        return glm::dvec3{q[0] - c.x, q[1] - c.y, q[2] - c.z};
     };
     const int nr = static_cast<int>(alpha.size());
     for (int s = 0; s < segs; ++s) add_oriented(face, front, ring(0, s), ring(0, s + 1), out(ring(0, s)));
@@ -500,11 +499,12 @@ void Generator::build_lashes(Face& face, int side, bool upper) {
     if (row.count == 0 || margin.size() < 3) return;
     auto point = [&](int v) {
         const auto q = face.mesh.point(TriMesh::VertexHandle(v));
-        return V3{q[0], q[1], q[2]};
+        return glm::dvec3{q[0], q[1], q[2]};
     };
     std::vector<double> arc(margin.size(), 0.0);
-    for (std::size_t i = 1; i < margin.size(); ++i) arc[i] = arc[i - 1] + length(point(margin[i]) - point(margin[i - 1]));
-    const V3 centre{p_.eye_centre[0] * (side == 0 ? 1.0 : -1.0), p_.eye_centre[1], p_.eye_centre[2]};
+    for (std::size_t i = 1; i < margin.size(); ++i)
+        arc[i] = arc[i - 1] + glm::length(point(margin[i]) - point(margin[i - 1]));
+    const glm::dvec3 centre{p_.eye_centre[0] * (side == 0 ? 1.0 : -1.0), p_.eye_centre[1], p_.eye_centre[2]};
     const double outward = side == 0 ? 1.0 : -1.0;  // +x towards this eye's outer corner
     std::mt19937 random(static_cast<unsigned>(1 + 2 * side + (upper ? 0 : 1)));
     auto uniform = [&] { return static_cast<double>(random()) / 4294967296.0; };
@@ -517,16 +517,15 @@ void Generator::build_lashes(Face& face, int side, bool upper) {
         std::size_t i = 1;
         while (i + 1 < arc.size() && arc[i] < at) ++i;
         const double t = (at - arc[i - 1]) / std::max(arc[i] - arc[i - 1], 1e-9);
-        const V3 a = point(margin[i - 1]), b = point(margin[i]);
-        const V3 root = a + (b - a) * t;
+        const glm::dvec3 a = point(margin[i - 1]), b = point(margin[i]);
+        const glm::dvec3 root = a + (b - a) * t;
         const int anchor = margin[t < 0.5 ? i - 1 : i];
         // The frame at the root: radial out of the eye, along the margin
         // towards the outer corner, and away from the opening.
-        const V3 radial = detail::normalised(root - centre);
-        V3 along = detail::normalised(b - a);
+        const glm::dvec3 radial = detail::normalised(root - centre);
+        glm::dvec3 along = detail::normalised(b - a);
         if (along.x * outward < 0) along = along * -1.0;
-        V3 away = detail::normalised(V3{along.y * radial.z - along.z * radial.y, along.z * radial.x - along.x * radial.z,
-                                        along.x * radial.y - along.y * radial.x});
+        glm::dvec3 away = detail::normalised(glm::cross(along, radial));
         if ((away.y > 0) != upper) away = away * -1.0;
         // Longest mid-lid, shortest at the inner end (FIDELITY.md).
         const double len = row.length * (0.45 + 0.55 * std::pow(std::sin(kPi * s), 0.6)) * (0.75 + 0.25 * s) *
@@ -534,14 +533,15 @@ void Generator::build_lashes(Face& face, int side, bool upper) {
         const double lift = (row.lift_deg + 12.0 * (uniform() - 0.5)) * kDeg;
         const double curl = row.curl_deg * (0.8 + 0.4 * uniform()) * kDeg;
         const double splay = 0.25 * (uniform() - 0.5) + 0.35 * (s - 0.5);  // outer lashes lean outwards
-        V3 p = root + radial * 0.3;  // from the lid's front edge
+        glm::dvec3 p = root + radial * 0.3;  // from the lid's front edge
         const int first = face.vertex_count();
         for (int c = 0; c < kSections; ++c) {
             const double f = static_cast<double>(c) / (kSections - 1);
             const double angle = lift + curl * f * f;
-            const V3 dir = detail::normalised(radial * std::cos(angle) + away * std::sin(angle) + along * splay);
+            const glm::dvec3 dir =
+                detail::normalised(radial * std::cos(angle) + away * std::sin(angle) + along * splay);
             const double half = 0.5 * row.width * (1.0 - 0.8 * f);
-            const V3 side_dir = detail::normalised(along - dir * detail::dot(along, dir));
+            const glm::dvec3 side_dir = detail::normalised(along - dir * glm::dot(along, dir));
             const double u = u0 + detail::kTile * (0.02 + 0.06 * f);
             add_vertex(face, p - side_dir * half, u, detail::kTile * 0.02, VertexPart::Skin);
             add_vertex(face, p + side_dir * half, u, detail::kTile * 0.08, VertexPart::Skin);
@@ -565,8 +565,8 @@ void Generator::build_mouth_interior(Face& face) {
     using detail::Tile;
     // Cavity: the back half of an ellipsoid, open towards the lips, seen from inside.
     {
-        const V3 cc{p_.cavity_centre[0], p_.cavity_centre[1], p_.cavity_centre[2]};
-        const V3 r{p_.cavity_radii[0], p_.cavity_radii[1], p_.cavity_radii[2]};
+        const glm::dvec3 cc{p_.cavity_centre[0], p_.cavity_centre[1], p_.cavity_centre[2]};
+        const glm::dvec3 r{p_.cavity_radii[0], p_.cavity_radii[1], p_.cavity_radii[2]};
         const int rings = 10, segs = 36;
         auto part_of = [&](double y) { return y >= cc.y ? VertexPart::MouthUpper : VertexPart::MouthLower; };
         auto uv = [&](double g, double s, double& u, double& v) {
@@ -576,13 +576,14 @@ void Generator::build_mouth_interior(Face& face) {
         };
         double u, v;
         uv(0, 0, u, v);
-        const int back = add_vertex(face, cc + V3{0, 0, -r.z}, u, v, part_of(cc.y)).idx();
+        const int back = add_vertex(face, cc + glm::dvec3{0, 0, -r.z}, u, v, part_of(cc.y)).idx();
         const int first = face.vertex_count();
         for (int k = 1; k <= rings; ++k) {
             const double g = 0.5 * kPi * k / rings;
             for (int s = 0; s < segs; ++s) {
                 const double a = 2 * kPi * s / segs;
-                const V3 q = cc + V3{r.x * std::sin(g) * std::cos(a), r.y * std::sin(g) * std::sin(a), -r.z * std::cos(g)};
+                const glm::dvec3 q = cc + glm::dvec3{r.x * std::sin(g) * std::cos(a), r.y * std::sin(g) * std::sin(a),
+                                                     -r.z * std::cos(g)};
                 uv(g, a, u, v);
                 add_vertex(face, q, u, v, part_of(q.y));
             }
@@ -590,7 +591,7 @@ void Generator::build_mouth_interior(Face& face) {
         auto ring = [&](int k, int s) { return first + k * segs + (s % segs); };
         auto inward = [&](int a) {
             const auto q = face.mesh.point(TriMesh::VertexHandle(a));
-            return V3{cc.x - q[0], cc.y - q[1], cc.z - q[2]};
+            return glm::dvec3{cc.x - q[0], cc.y - q[1], cc.z - q[2]};
         };
         for (int s = 0; s < segs; ++s) add_oriented(face, back, ring(0, s), ring(0, s + 1), inward(ring(0, s)));
         for (int k = 0; k + 1 < rings; ++k)
@@ -615,13 +616,14 @@ void Generator::build_mouth_interior(Face& face) {
         const int first = face.vertex_count();
         for (int k = 0; k <= sections; ++k) {
             const double tau = (-0.5 + static_cast<double>(k) / sections) * kPi * 0.92;
-            const V3 front{W * std::sin(tau), 0.0, z0 - p_.teeth_depth * (1.0 - std::cos(tau))};
+            const glm::dvec3 front{W * std::sin(tau), 0.0, z0 - p_.teeth_depth * (1.0 - std::cos(tau))};
             // Inward normal of the arch, an ellipse centred at z0 - depth.
             const double zc = z0 - p_.teeth_depth;
-            const V3 in = detail::normalised(
-                V3{-front.x / (W * W), 0.0, -(front.z - zc) / (p_.teeth_depth * p_.teeth_depth)});
-            const V3 sec[4] = {front + V3{0, y_root, 0}, front + V3{0, y_edge, 0},
-                               front + in * thickness + V3{0, y_edge, 0}, front + in * thickness + V3{0, y_root, 0}};
+            const glm::dvec3 in = detail::normalised(
+                glm::dvec3{-front.x / (W * W), 0.0, -(front.z - zc) / (p_.teeth_depth * p_.teeth_depth)});
+            const glm::dvec3 sec[4] = {front + glm::dvec3{0, y_root, 0}, front + glm::dvec3{0, y_edge, 0},
+                                       front + in * thickness + glm::dvec3{0, y_edge, 0},
+                                       front + in * thickness + glm::dvec3{0, y_root, 0}};
             for (int c = 0; c < 4; ++c) {
                 const double u = detail::tile_u0(Tile::Teeth) + detail::kTile * (0.02 + 0.96 * k / sections);
                 const double v = detail::kTile * ((upper ? 0.5 : 0.0) + 0.02 + 0.46 * c / 3.0);
@@ -633,14 +635,14 @@ void Generator::build_mouth_interior(Face& face) {
                 const int c2 = (c + 1) % 4;
                 const int a = first + 4 * k + c, b = first + 4 * (k + 1) + c;
                 const int d = first + 4 * k + c2, e = first + 4 * (k + 1) + c2;
-                V3 centre{}, mid{};
+                glm::dvec3 centre{0.0}, mid{0.0};
                 for (int q = 0; q < 4; ++q) {
                     const auto pq = face.mesh.point(TriMesh::VertexHandle(first + 4 * k + q));
-                    centre = centre + V3{pq[0], pq[1], pq[2]} * 0.25;
+                    centre = centre + glm::dvec3{pq[0], pq[1], pq[2]} * 0.25;
                 }
                 const auto pa = face.mesh.point(TriMesh::VertexHandle(a));
                 const auto pd = face.mesh.point(TriMesh::VertexHandle(d));
-                mid = V3{0.5 * (pa[0] + pd[0]), 0.5 * (pa[1] + pd[1]), 0.5 * (pa[2] + pd[2])};
+                mid = glm::dvec3{0.5 * (pa[0] + pd[0]), 0.5 * (pa[1] + pd[1]), 0.5 * (pa[2] + pd[2])};
                 add_oriented(face, a, b, e, mid - centre);
                 add_oriented(face, a, e, d, mid - centre);
             }
@@ -652,8 +654,8 @@ void Generator::build_mouth_interior(Face& face) {
 
     // Tongue: an ellipsoid resting on the cavity floor, tip (+z pole) forward.
     {
-        const V3 tc{p_.tongue_centre[0], p_.tongue_centre[1], p_.tongue_centre[2]};
-        const V3 r{p_.tongue_radii[0], p_.tongue_radii[1], p_.tongue_radii[2]};
+        const glm::dvec3 tc{p_.tongue_centre[0], p_.tongue_centre[1], p_.tongue_centre[2]};
+        const glm::dvec3 r{p_.tongue_radii[0], p_.tongue_radii[1], p_.tongue_radii[2]};
         tongue_rings_ = 10;
         tongue_segments_ = 16;
         auto uv = [&](double a, double b, double& u, double& v) {
@@ -664,25 +666,27 @@ void Generator::build_mouth_interior(Face& face) {
         tongue_first_ = face.vertex_count();
         double u, v;
         uv(0, 0, u, v);
-        const int tip = add_vertex(face, tc + V3{0, 0, r.z}, u, v, VertexPart::Tongue).idx();
+        const int tip = add_vertex(face, tc + glm::dvec3{0, 0, r.z}, u, v, VertexPart::Tongue).idx();
         const int first = face.vertex_count();
         for (int k = 1; k < tongue_rings_; ++k) {
             const double a = kPi * k / tongue_rings_;
             for (int s = 0; s < tongue_segments_; ++s) {
                 const double b = 2 * kPi * s / tongue_segments_;
                 uv(a, b, u, v);
-                add_vertex(face, tc + V3{r.x * std::sin(a) * std::cos(b), r.y * std::sin(a) * std::sin(b), r.z * std::cos(a)},
+                add_vertex(face,
+                           tc + glm::dvec3{r.x * std::sin(a) * std::cos(b), r.y * std::sin(a) * std::sin(b),
+                                           r.z * std::cos(a)},
                            u, v, VertexPart::Tongue);
             }
         }
         uv(kPi, 0, u, v);
-        const int root = add_vertex(face, tc + V3{0, 0, -r.z}, u, v, VertexPart::Tongue).idx();
+        const int root = add_vertex(face, tc + glm::dvec3{0, 0, -r.z}, u, v, VertexPart::Tongue).idx();
         tongue_count_ = face.vertex_count() - tongue_first_;
         const int segs = tongue_segments_, nr = tongue_rings_ - 1;
         auto ring = [&](int k, int s) { return first + k * segs + (s % segs); };
         auto out = [&](int a) {
             const auto q = face.mesh.point(TriMesh::VertexHandle(a));
-            return V3{q[0] - tc.x, q[1] - tc.y, q[2] - tc.z};
+            return glm::dvec3{q[0] - tc.x, q[1] - tc.y, q[2] - tc.z};
         };
         for (int s = 0; s < segs; ++s) add_oriented(face, tip, ring(0, s), ring(0, s + 1), out(ring(0, s)));
         for (int k = 0; k + 1 < nr; ++k)
@@ -702,7 +706,7 @@ void Generator::place_feature_points(Face& face) {
         face.feature_points[k] = FeaturePointLocation{true, v, {q[0], q[1], q[2]}};
         placed[k] = true;
     };
-    auto set_free = [&](const char* id, V3 p) {
+    auto set_free = [&](const char* id, glm::dvec3 p) {
         const int k = fap::feature_point_index(id);
         face.feature_points[k] = FeaturePointLocation{true, -1, {p.x, p.y, p.z}};
         placed[k] = true;
@@ -787,12 +791,12 @@ void Generator::place_feature_points(Face& face) {
         }
         return best;
     };
-    auto nearest_3d = [&](V3 t) {
+    auto nearest_3d = [&](glm::dvec3 t) {
         int best = 0;
         double best_d = std::numeric_limits<double>::max();
         for (int v = 0; v < skin_end; ++v) {
             const auto q = face.mesh.point(TriMesh::VertexHandle(v));
-            const double d = length(V3{q[0] - t.x, q[1] - t.y, q[2] - t.z});
+            const double d = glm::length(glm::dvec3{q[0] - t.x, q[1] - t.y, q[2] - t.z});
             if (d < best_d) {
                 best_d = d;
                 best = v;

@@ -14,7 +14,7 @@ using Rgb = std::array<double, 3>;
 Rgb scaled(Rgb c, double s) { return {c[0] * s, c[1] * s, c[2] * s}; }
 Rgb tinted(Rgb c, Rgb t) { return {c[0] * t[0], c[1] * t[1], c[2] * t[2]}; }
 Rgb blend(Rgb a, Rgb b, double t) { return {mix(a[0], b[0], t), mix(a[1], b[1], t), mix(a[2], b[2], t)}; }
-Rgb from255(const Vec3& c) { return {c[0] / 255.0, c[1] / 255.0, c[2] / 255.0}; }
+Rgb from255(const glm::dvec3& c) { return {c[0] / 255.0, c[1] / 255.0, c[2] / 255.0}; }
 
 // Angular difference wrapped to [-pi, pi].
 double wrapped(double a) { return std::remainder(a, 2.0 * kPi); }

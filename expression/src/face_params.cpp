@@ -5,13 +5,16 @@
 namespace emoface::expression::detail {
 namespace {
 
+glm::dvec2 to_glm(const std::array<double, 2>& a) { return {a[0], a[1]}; }
+glm::dvec3 to_glm(const std::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
+
 Ellipsoid read_ellipsoid(JsonReader r) {
     Ellipsoid e;
-    e.centre = r.numbers<3>("centre");
-    e.radii = r.numbers<3>("radii");
+    e.centre = to_glm(r.numbers<3>("centre"));
+    e.radii = to_glm(r.numbers<3>("radii"));
     e.tilt_deg = r.number("tilt_deg", 0.0);
-    for (double v : e.radii)
-        if (!(v > 0.0)) r.at("radii").fail("3 positive radii");
+    for (int i = 0; i < 3; ++i)
+        if (!(e.radii[i] > 0.0)) r.at("radii").fail("3 positive radii");
     r.finish();
     return e;
 }
@@ -41,8 +44,8 @@ std::vector<RowKey> read_row_keys(JsonReader& r, const std::string& key) {
 Bump read_bump(JsonReader b) {
     Bump out;
     out.name = b.string("name");
-    out.centre = b.numbers<2>("centre");
-    out.radius = b.numbers<2>("radius");
+    out.centre = to_glm(b.numbers<2>("centre"));
+    out.radius = to_glm(b.numbers<2>("radius"));
     out.height = b.number("height");
     out.angle_deg = b.number("angle_deg", 0.0);
     out.mirror = b.boolean("mirror", false);
@@ -51,7 +54,7 @@ Bump read_bump(JsonReader b) {
     return out;
 }
 
-Vec3 colour(JsonReader& r, const std::string& key) { return r.numbers<3>(key); }
+glm::dvec3 colour(JsonReader& r, const std::string& key) { return to_glm(r.numbers<3>(key)); }
 
 }  // namespace
 
@@ -79,7 +82,7 @@ FaceParams read_face_params(const std::string& params_dir) {
             p.jaw = read_ellipsoid(r.object("jaw"));
             JsonReader neck = r.object("neck");
             p.neck_centre_z = neck.number("centre_z");
-            p.neck_radii = neck.numbers<2>("radii");
+            p.neck_radii = to_glm(neck.numbers<2>("radii"));
             p.neck_top_y = neck.number("top_y");
             p.neck_blend = neck.number("blend");
             neck.finish();
@@ -88,12 +91,12 @@ FaceParams read_face_params(const std::string& params_dir) {
         }
         {
             JsonReader r = top.object("eyes");
-            p.eye_centre = r.numbers<3>("centre");
+            p.eye_centre = to_glm(r.numbers<3>("centre"));
             p.eye_radius = r.number("radius");
             p.iris_radius = r.number("iris_radius");
             p.pupil_radius = r.number("pupil_radius");
-            p.inner_corner = r.numbers<2>("inner_corner");
-            p.outer_corner = r.numbers<2>("outer_corner");
+            p.inner_corner = to_glm(r.numbers<2>("inner_corner"));
+            p.outer_corner = to_glm(r.numbers<2>("outer_corner"));
             p.upper_lid_height = r.number("upper_lid_height");
             p.lower_lid_height = r.number("lower_lid_height");
             p.upper_lid_peak = r.number("upper_lid_peak");
@@ -145,14 +148,14 @@ FaceParams read_face_params(const std::string& params_dir) {
         }
         {
             JsonReader r = top.object("mouth_interior");
-            p.cavity_centre = r.numbers<3>("cavity_centre");
-            p.cavity_radii = r.numbers<3>("cavity_radii");
+            p.cavity_centre = to_glm(r.numbers<3>("cavity_centre"));
+            p.cavity_radii = to_glm(r.numbers<3>("cavity_radii"));
             p.teeth_half_width = r.number("teeth_half_width");
             p.teeth_height = r.number("teeth_height");
             p.teeth_depth = r.number("teeth_depth");
             p.teeth_gap = r.number("teeth_gap");
-            p.tongue_centre = r.numbers<3>("tongue_centre");
-            p.tongue_radii = r.numbers<3>("tongue_radii");
+            p.tongue_centre = to_glm(r.numbers<3>("tongue_centre"));
+            p.tongue_radii = to_glm(r.numbers<3>("tongue_radii"));
             r.finish();
         }
         for (JsonReader b : top.objects("bumps")) p.bumps.push_back(read_bump(b));
@@ -161,7 +164,7 @@ FaceParams read_face_params(const std::string& params_dir) {
             Ridge ridge;
             ridge.name = rr.string("name");
             const JsonReader points = rr.at("points");
-            for (const JsonReader& pt : points.elements()) ridge.points.push_back(pt.as_numbers<2>());
+            for (const JsonReader& pt : points.elements()) ridge.points.push_back(to_glm(pt.as_numbers<2>()));
             if (ridge.points.size() < 2) points.fail("at least 2 points");
             ridge.width = rr.number_list("width");
             ridge.height = rr.number_list("height");
@@ -176,21 +179,21 @@ FaceParams read_face_params(const std::string& params_dir) {
         }
         {
             JsonReader r = top.object("ears");
-            p.ear_centre_yz = r.numbers<2>("centre_yz");
-            p.ear_radii_yz = r.numbers<2>("radii_yz");
+            p.ear_centre_yz = to_glm(r.numbers<2>("centre_yz"));
+            p.ear_radii_yz = to_glm(r.numbers<2>("radii_yz"));
             p.ear_height = r.number("height");
             r.finish();
         }
         {
             JsonReader r = top.object("pivots");
-            p.jaw_pivot = r.numbers<3>("jaw");
-            p.head_pivot = r.numbers<3>("head");
+            p.jaw_pivot = to_glm(r.numbers<3>("jaw"));
+            p.head_pivot = to_glm(r.numbers<3>("head"));
             r.finish();
         }
         {
             JsonReader r = top.object("texture_box");
-            p.texture_box_min = r.numbers<2>("min");
-            p.texture_box_max = r.numbers<2>("max");
+            p.texture_box_min = to_glm(r.numbers<2>("min"));
+            p.texture_box_max = to_glm(r.numbers<2>("max"));
             r.finish();
         }
         {
@@ -218,14 +221,15 @@ FaceParams read_face_params(const std::string& params_dir) {
         }
         {
             JsonReader r = top.object("brows");
-            p.brow_points = {r.numbers<2>("inner"), r.numbers<2>("peak"), r.numbers<2>("outer")};
-            p.brow_thickness = r.numbers<3>("thickness");
+            p.brow_points = {to_glm(r.numbers<2>("inner")), to_glm(r.numbers<2>("peak")),
+                             to_glm(r.numbers<2>("outer"))};
+            p.brow_thickness = to_glm(r.numbers<3>("thickness"));
             r.finish();
         }
         {
             JsonReader r = top.object("hair");
             p.hairline_y = r.number("hairline_y");
-            p.hairline_temple = r.numbers<2>("temple");
+            p.hairline_temple = to_glm(r.numbers<2>("temple"));
             p.sideburn_z = r.number("sideburn_z");
             p.sideburn_bottom_y = r.number("sideburn_bottom_y");
             p.hair_back_bottom_y = r.number("back_bottom_y");

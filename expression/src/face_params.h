@@ -8,16 +8,16 @@
 #include <string>
 #include <vector>
 
-namespace emoface::expression::detail {
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
 
-using Vec2 = std::array<double, 2>;
-using Vec3 = std::array<double, 3>;
+namespace emoface::expression::detail {
 
 // An ellipsoid pitched by tilt_deg about the x axis (positive: its front end
 // goes down), as the mandible runs from the chin up to the jaw angle.
 struct Ellipsoid {
-    Vec3 centre{};
-    Vec3 radii{};
+    glm::dvec3 centre{0.0};
+    glm::dvec3 radii{0.0};
     double tilt_deg = 0.0;
 };
 
@@ -25,8 +25,8 @@ struct Ellipsoid {
 // height * (1 - rho^2)^3, rho the rotated, normalised distance from centre.
 struct Bump {
     std::string name;
-    Vec2 centre{};
-    Vec2 radius{};
+    glm::dvec2 centre{0.0};
+    glm::dvec2 radius{0.0};
     double height = 0.0;
     double angle_deg = 0.0;
     bool mirror = false;
@@ -36,7 +36,7 @@ struct Bump {
 // cross-section (1 - (d / width)^2)^3, d the distance to the polyline.
 struct Ridge {
     std::string name;
-    std::vector<Vec2> points;
+    std::vector<glm::dvec2> points;
     std::vector<double> width;
     std::vector<double> height;
     bool mirror = false;
@@ -71,14 +71,14 @@ struct FaceParams {
     // head volume (smooth union)
     Ellipsoid skull, lower_face, jaw;
     double neck_centre_z = 0.0;
-    Vec2 neck_radii{};
+    glm::dvec2 neck_radii{0.0};
     double neck_top_y = 0.0, neck_blend = 0.0;
     double blend = 0.0;
 
     // eyes (left eye; the right one mirrors it)
-    Vec3 eye_centre{};
+    glm::dvec3 eye_centre{0.0};
     double eye_radius = 0.0, iris_radius = 0.0, pupil_radius = 0.0;
-    Vec2 inner_corner{}, outer_corner{};
+    glm::dvec2 inner_corner{0.0}, outer_corner{0.0};
     double upper_lid_height = 0.0, lower_lid_height = 0.0;
     double upper_lid_peak = 0.5, lower_lid_peak = 0.5;
     double lid_clearance = 0.0, lid_thickness = 0.0;
@@ -106,12 +106,12 @@ struct FaceParams {
     double outer_corner_offset = 0.0;
 
     // mouth interior
-    Vec3 cavity_centre{};
-    Vec3 cavity_radii{};
+    glm::dvec3 cavity_centre{0.0};
+    glm::dvec3 cavity_radii{0.0};
     double teeth_half_width = 0.0, teeth_height = 0.0, teeth_depth = 0.0;
     double teeth_gap = 0.0;
-    Vec3 tongue_centre{};
-    Vec3 tongue_radii{};
+    glm::dvec3 tongue_centre{0.0};
+    glm::dvec3 tongue_radii{0.0};
 
     // relief
     std::vector<Bump> bumps;
@@ -119,28 +119,29 @@ struct FaceParams {
     std::vector<Bump> nostrils;  // dents painted dark
 
     // ears (left; mirrored)
-    Vec2 ear_centre_yz{};
-    Vec2 ear_radii_yz{};
+    glm::dvec2 ear_centre_yz{0.0};
+    glm::dvec2 ear_radii_yz{0.0};
     double ear_height = 0.0;
 
     // pivots
-    Vec3 jaw_pivot{};
-    Vec3 head_pivot{};
-    Vec2 texture_box_min{}, texture_box_max{};
+    glm::dvec3 jaw_pivot{0.0};
+    glm::dvec3 head_pivot{0.0};
+    glm::dvec2 texture_box_min{0.0}, texture_box_max{0.0};
 
     // feature points placed by target: [x, y] = nearest front-facing skin
     // vertex in frontal projection; [x, y, z] = nearest skin vertex in 3D.
     std::map<std::string, std::vector<double>> feature_targets;
 
     // colours (sRGB 0..255)
-    Vec3 skin{}, lips{}, brows{}, hair{}, iris{}, iris_inner{}, sclera{}, lashes{}, mouth{}, teeth{}, tongue{};
+    glm::dvec3 skin{0.0}, lips{0.0}, brows{0.0}, hair{0.0}, iris{0.0}, iris_inner{0.0}, sclera{0.0}, lashes{0.0};
+    glm::dvec3 mouth{0.0}, teeth{0.0}, tongue{0.0};
     // brows (left): inner, peak, outer points and thickness at each
-    std::array<Vec2, 3> brow_points{};
-    Vec3 brow_thickness{};
+    std::array<glm::dvec2, 3> brow_points{};
+    glm::dvec3 brow_thickness{0.0};
     // hairline: front height at x = 0, temple point (x, y), how far down the
     // hair reaches at the sides (sideburn) and back
     double hairline_y = 0.0;
-    Vec2 hairline_temple{};
+    glm::dvec2 hairline_temple{0.0};
     double sideburn_z = 0.0, sideburn_bottom_y = 0.0, hair_back_bottom_y = 0.0;
 };
 

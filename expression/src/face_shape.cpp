@@ -8,14 +8,14 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-double ellipsoid_field(V3 p, const Ellipsoid& e) {
+double ellipsoid_field(glm::dvec3 p, const Ellipsoid& e) {
     const double t = e.tilt_deg * kPi / 180.0;
-    const V3 d{p.x - e.centre[0], p.y - e.centre[1], p.z - e.centre[2]};
+    const glm::dvec3 d{p.x - e.centre[0], p.y - e.centre[1], p.z - e.centre[2]};
     const double ly = d.y * std::cos(t) + d.z * std::sin(t);
     const double lz = -d.y * std::sin(t) + d.z * std::cos(t);
-    const V3 q{d.x / e.radii[0], ly / e.radii[1], lz / e.radii[2]};
+    const glm::dvec3 q{d.x / e.radii[0], ly / e.radii[1], lz / e.radii[2]};
     const double rmin = std::min({e.radii[0], e.radii[1], e.radii[2]});
-    return (length(q) - 1.0) * rmin;
+    return (glm::length(q) - 1.0) * rmin;
 }
 
 // Polynomial smooth minimum: the union of two volumes with a fillet of size k.
@@ -112,7 +112,7 @@ void FaceShape::set_eye_corners(double x_in, double x_out) {
     eye.x_out = x_out;
 }
 
-double FaceShape::field(V3 p) const {
+double FaceShape::field(glm::dvec3 p) const {
     double f = smooth_min(ellipsoid_field(p, p_.skull), ellipsoid_field(p, p_.lower_face), p_.blend);
     f = smooth_min(f, ellipsoid_field(p, p_.jaw), p_.blend);
     // The neck: a vertical elliptic cylinder, capped inside the head.
@@ -122,15 +122,15 @@ double FaceShape::field(V3 p) const {
     return smooth_min(f, neck, p_.neck_blend);
 }
 
-V3 FaceShape::field_normal(V3 p) const {
+glm::dvec3 FaceShape::field_normal(glm::dvec3 p) const {
     const double h = 0.05;
-    const V3 g{field({p.x + h, p.y, p.z}) - field({p.x - h, p.y, p.z}),
+    const glm::dvec3 g{field({p.x + h, p.y, p.z}) - field({p.x - h, p.y, p.z}),
                field({p.x, p.y + h, p.z}) - field({p.x, p.y - h, p.z}),
                field({p.x, p.y, p.z + h}) - field({p.x, p.y, p.z - h})};
     return normalised(g);
 }
 
-double FaceShape::cast(V3 origin, V3 dir) const {
+double FaceShape::cast(glm::dvec3 origin, glm::dvec3 dir) const {
     constexpr double kStep = 1.5, kMax = 600.0;
     double lo = 0.0, hi = kStep;
     while (hi < kMax && field(origin + dir * hi) < 0.0) {
@@ -244,9 +244,9 @@ double FaceShape::ear_relief(double y, double z) const {
     return std::max(h, 0.0);
 }
 
-V3 FaceShape::displace(V3 base) const {
-    const V3 n = field_normal(base);
-    V3 p = base;
+glm::dvec3 FaceShape::displace(glm::dvec3 base) const {
+    const glm::dvec3 n = field_normal(base);
+    glm::dvec3 p = base;
     const double front = glm::smoothstep(0.05, 0.45, n.z);
     if (front > 0.0) {
         p.z += relief(base.x, base.y) * front;

@@ -9,21 +9,16 @@
 #include <cmath>
 
 #include <glm/common.hpp>
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
 
 #include "face_params.h"
 
 namespace emoface::expression::detail {
 
-struct V3 {
-    double x = 0, y = 0, z = 0;
-};
-inline V3 operator+(V3 a, V3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-inline V3 operator-(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-inline V3 operator*(V3 a, double s) { return {a.x * s, a.y * s, a.z * s}; }
-inline double dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-inline double length(V3 a) { return std::sqrt(dot(a, a)); }
-inline V3 normalised(V3 a) {
-    const double l = length(a);
+// glm::normalize, except that a zero vector stays zero (glm gives NaN).
+inline glm::dvec3 normalised(const glm::dvec3& a) {
+    const double l = glm::length(a);
     return l > 0 ? a * (1.0 / l) : a;
 }
 
@@ -51,13 +46,13 @@ public:
     const FaceParams& params() const { return p_; }
 
     // Head volume: negative inside.
-    double field(V3 p) const;
-    V3 field_normal(V3 p) const;
+    double field(glm::dvec3 p) const;
+    glm::dvec3 field_normal(glm::dvec3 p) const;
     // Distance along a unit direction from an inside origin to the head volume's surface.
-    double cast(V3 origin, V3 dir) const;
+    double cast(glm::dvec3 origin, glm::dvec3 dir) const;
 
     // The final skin position for a point on the head volume's surface.
-    V3 displace(V3 base) const;
+    glm::dvec3 displace(glm::dvec3 base) const;
 
     // Frontal relief along z at (x, y), without the eyelid blend.
     double relief(double x, double y) const;

@@ -17,7 +17,7 @@ struct Rgb {
 Rgb operator*(Rgb c, double s) { return {c.r * s, c.g * s, c.b * s}; }
 Rgb operator*(Rgb a, Rgb b) { return {a.r * b.r, a.g * b.g, a.b * b.b}; }
 Rgb blend(Rgb a, Rgb b, double t) { return {mix(a.r, b.r, t), mix(a.g, b.g, t), mix(a.b, b.b, t)}; }
-Rgb from255(const Vec3& c) { return {c[0] / 255.0, c[1] / 255.0, c[2] / 255.0}; }
+Rgb from255(const glm::dvec3& c) { return {c[0] / 255.0, c[1] / 255.0, c[2] / 255.0}; }
 
 double hash(int x, int y, int z) {
     std::uint32_t h = static_cast<std::uint32_t>(x) * 374761393u + static_cast<std::uint32_t>(y) * 668265263u +
@@ -50,12 +50,12 @@ class Painter {
 public:
     explicit Painter(const FaceShape& shape) : s_(shape), p_(shape.params()) {}
 
-    Rgb skin(V3 q) const;
+    Rgb skin(glm::dvec3 q) const;
     Rgb tile(double u, double v) const;
 
 private:
     double brow_density(double x, double y) const;
-    bool hair(V3 q, double* amount) const;
+    bool hair(glm::dvec3 q, double* amount) const;
 
     const FaceShape& s_;
     const FaceParams& p_;
@@ -63,11 +63,11 @@ private:
 
 double Painter::brow_density(double x, double y) const {
     const double sx = x >= 0 ? 1.0 : -1.0;
-    const Vec2 a{p_.brow_points[0][0] * sx, p_.brow_points[0][1]};
-    const Vec2 m{p_.brow_points[1][0] * sx, p_.brow_points[1][1]};
-    const Vec2 b{p_.brow_points[2][0] * sx, p_.brow_points[2][1]};
+    const glm::dvec2 a{p_.brow_points[0][0] * sx, p_.brow_points[0][1]};
+    const glm::dvec2 m{p_.brow_points[1][0] * sx, p_.brow_points[1][1]};
+    const glm::dvec2 b{p_.brow_points[2][0] * sx, p_.brow_points[2][1]};
     // Quadratic curve through a, m (at t = 0.5) and b.
-    const Vec2 c{2 * m[0] - 0.5 * (a[0] + b[0]), 2 * m[1] - 0.5 * (a[1] + b[1])};
+    const glm::dvec2 c{2 * m[0] - 0.5 * (a[0] + b[0]), 2 * m[1] - 0.5 * (a[1] + b[1])};
     double best = 1e9, best_t = 0, best_sd = 0;
     constexpr int kSamples = 48;
     for (int k = 0; k <= kSamples; ++k) {
@@ -95,7 +95,7 @@ double Painter::brow_density(double x, double y) const {
     return std::clamp(m_edge * (0.55 + 0.7 * strands), 0.0, 1.0);
 }
 
-bool Painter::hair(V3 q, double* amount) const {
+bool Painter::hair(glm::dvec3 q, double* amount) const {
     const double ax = std::abs(q.x);
     // Front: the hairline over the forehead, dropping at the temples.
     const double tx = std::min(ax / p_.hairline_temple[0], 1.0);
@@ -131,7 +131,7 @@ double field(double x, double y, double cx, double cy, double sx, double sy) {
     return std::exp(-0.5 * (dx * dx + dy * dy));
 }
 
-Rgb Painter::skin(V3 q) const {
+Rgb Painter::skin(glm::dvec3 q) const {
     const Rgb skin = from255(p_.skin);
     // Gentle pigment variation at two scales (MATTS: even skin reads young,
     // so it stays within a few percent), and haemoglobin mottling apart from
@@ -277,7 +277,7 @@ Image paint_base_colour(const FaceShape& shape, const TriMesh& mesh, int size) {
 
     for (auto fh : mesh.faces()) {
         double tu[3], tv[3];
-        V3 pos[3];
+        glm::dvec3 pos[3];
         int k = 0;
         for (auto vh : mesh.fv_range(fh)) {
             const auto t = mesh.texcoord2D(vh);
