@@ -34,15 +34,7 @@
 namespace {
 
 using namespace emoface;
-using render::testing::Tolerance;
-
-// As the default face's goldens (golden_test.cpp): same code and Mesa give
-// the same bytes; the morph's SIMD and plain loops may round a wrinkle pixel
-// by one step, another llvmpipe may move a silhouette sample. Drawing this
-// picture without its painted maps moves the mean far more (checked below).
-constexpr Tolerance kTolerance{48, 0.04,
-                               "same code and Mesa: identical; other CPUs or Mesa versions: "
-                               "1-step wrinkle rounding and a few silhouette pixels"};
+using render::testing::kFaceTolerance;
 
 constexpr int kMapSize = 512;
 constexpr int kImageSize = 512;
@@ -431,7 +423,7 @@ TEST_F(AnchoredLayout, MatchesTheCommittedImage) {
     const render::ImageRGBA8 image = render::testing::downsample2x(draw("0.5 anger + 0.5 surprise"));
     const auto result = render::testing::compare_with_golden(
         image, std::string(EMOFACE_TEST_SOURCE_DIR) + "/goldens/anchored_painted_anger50_surprise50.png",
-        kTolerance, "golden-failures");
+        kFaceTolerance, "golden-failures");
     if (result.updated) std::printf("%s\n", result.message.c_str());
     EXPECT_TRUE(result.ok) << result.message;
     // The tolerance tells this picture from the same one without its maps.
@@ -442,7 +434,7 @@ TEST_F(AnchoredLayout, MatchesTheCommittedImage) {
         if (i % 4 != 3) sum += std::abs(int(image.pixels[i]) - int(without.pixels[i]));
     const double mean = sum / (3.0 * image.width * image.height);
     std::printf("with vs without the painted maps: mean %.3f\n", mean);
-    EXPECT_GT(mean, 2.0 * kTolerance.mean_diff);
+    EXPECT_GT(mean, 2.0 * kFaceTolerance.mean_diff);
 }
 
 TEST(AnchoredLayoutErrors, AFaceWithoutUvsIsRefused) {

@@ -21,20 +21,7 @@
 namespace {
 
 using namespace emoface;
-using render::testing::Tolerance;
-
-// Same code and Mesa as when the goldens were made gives the same bytes; the
-// tolerance absorbs what may differ between machines: the morph's AVX2 and
-// plain row loops round the last bit differently (a wrinkle pixel off by one
-// step here and there: a mean of about 0.001), and a different llvmpipe may
-// place a silhouette sample differently (single pixels off by up to ~40
-// after the 2x reduction). A real change is far outside: drawing anger
-// without its wrinkle map moves the mean by 0.16 (the wrinkles cover a small
-// part of the picture; ToleranceSeparatesWrinklesFromNoWrinkles keeps this
-// true), another emotion by more.
-constexpr Tolerance kFaceTolerance{48, 0.04,
-                                   "same code and Mesa: identical; other CPUs or Mesa versions: "
-                                   "1-step wrinkle rounding and a few silhouette pixels"};
+using render::testing::kFaceTolerance;
 
 struct GoldenCase {
     std::string name;
