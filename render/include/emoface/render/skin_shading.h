@@ -94,7 +94,7 @@ struct SkinShading {
 
     // --- specular: two GGX lobes with Fresnel ---
     float f0 = 0.028f;
-    std::array<float, 2> roughness{0.38f, 0.18f};
+    std::array<float, 2> roughness{0.45f, 0.70f};
     float lobe_weight = 0.85f;  // of roughness[0]; the other lobe gets the rest
 
     // --- pores ---
@@ -104,7 +104,7 @@ struct SkinShading {
 
     // --- light rig (the key light is the draw's Light) ---
     RigLight fill{{0.7f, 0.1f, 0.7f}, {0.16f, 0.17f, 0.19f}};
-    RigLight rim{{0.5f, 0.6f, -0.65f}, {0.55f, 0.52f, 0.48f}};
+    RigLight rim{{0.5f, 0.6f, -0.65f}, {0.36f, 0.34f, 0.31f}};
     glm::vec3 sky{0.22f, 0.23f, 0.25f};     // ambient from above (+y)
     glm::vec3 ground{0.10f, 0.08f, 0.07f};  // ambient from below (warm bounce)
     float exposure = 1.0f;
