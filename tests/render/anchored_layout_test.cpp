@@ -234,7 +234,13 @@ protected:
         scene_->update(state.faps, key_weights ? *key_weights : render::key_weights(state.mix));
         platform_->begin_frame();
         render::DrawOptions d = draw_options(wrinkles);
-        if (light) d.light = *light;
+        // A measuring light is the only light: the thesis's one-light
+        // Blinn-Phong, not the skin model's rig of key, fill, rim and sky,
+        // whose other lights would pull a mark's shading off its centre.
+        if (light) {
+            d.light = *light;
+            d.shading = render::Shading::Thesis;
+        }
         scene_->draw(d);
         platform_->end_frame();
         render::ImageRGBA8 image = platform_->read_rgba();
