@@ -8,6 +8,7 @@
 #include "emoface/common/error.h"
 #include "emoface/expression/emotion.h"
 #include "emoface/expression/profiles.h"
+#include "support/expect_error.h"
 
 namespace emoface::expression {
 namespace {
@@ -84,12 +85,8 @@ TEST(EmotionMix, RejectsWithMessagesThatNameThePart) {
         {"anger=nan", "expression: emotion mix \"anger=nan\": part 1 (\"anger=nan\"): \"nan\" is not a number"},
     };
     for (const Case& c : cases) {
-        try {
-            parse_emotion_mix(c.text);
-            ADD_FAILURE() << "accepted \"" << c.text << "\"";
-        } catch (const InputError& e) {
-            EXPECT_EQ(std::string(e.what()), c.message);
-        }
+        SCOPED_TRACE(c.text);
+        testing::expect_error<InputError>([&] { parse_emotion_mix(c.text); }, c.message);
     }
 }
 
@@ -142,12 +139,8 @@ TEST(EmotionMix, RejectsBadActionUnits) {
                     "in [0, 1]"},
     };
     for (const Case& c : cases) {
-        try {
-            parse_emotion_mix(c.text);
-            ADD_FAILURE() << "accepted \"" << c.text << "\"";
-        } catch (const InputError& e) {
-            EXPECT_EQ(std::string(e.what()), c.message);
-        }
+        SCOPED_TRACE(c.text);
+        testing::expect_error<InputError>([&] { parse_emotion_mix(c.text); }, c.message);
     }
 }
 
