@@ -57,7 +57,9 @@ void main() {
 //           (the framebuffer is plain RGBA8, so the encoding is the same on
 //           every GL and the PNG holds what was computed);
 //   skin:   pre-integrated scattering, two GGX lobes with Fresnel, pores,
-//           cavity and specular occlusion, a key/fill/rim/hemisphere rig,
+//           cavity and specular occlusion, a key/fill/rim/hemisphere rig
+//           (the full model for the key light; fill and rim reduced to
+//           one table lookup and one GGX lobe),
 //           exposure and tone mapping, then the same sRGB encoding.
 // Light intensities follow the thesis's convention: a light of colour I
 // lights a white Lambert surface facing it to I (I = E / pi), so a BRDF f
@@ -162,53 +164,70 @@ vec3 hemisphere(vec3 dir) {
 
 struct Surface {
     vec3 n;          // shading normal (bumped, pores)
-    vec3 n_geo;      // interpolated geometric normal
     vec3 v;          // towards the eye
-    vec3 albedo;
+    float n_dot_v;
+    vec3 n_r, n_g, n_b;   // per-channel softened diffuse normals (skin)
+    vec3 diffuse_albedo;  // albedo x the diffuse share (1 - sheen)
+    float direct_cavity;  // the cavity's dimming of direct diffuse light
     float curvature; // table row coordinate in [0, 1]
     float f0;
     vec2 alpha;      // GGX alpha of the two lobes
+    float alpha_mean;  // one lobe standing for both (fill and rim)
     float lobe_weight;
     float cavity;    // 1 open skin, 0 a deep crevice
-    float diffuse_share;  // 1 - the sheen's directional albedo
 };
 
-// One light's contribution (colour `c`, direction `l` towards it).
-vec3 shade_light(Surface s, vec3 l, vec3 c) {
-    float n_dot_v = max(dot(s.n, s.v), 1e-4);
+// The key light's contribution (colour `c`, direction `l` towards it): the
+// full model, each channel's softened normal looked up in the scattering
+// table, and the two GGX lobes.
+vec3 shade_key(Surface s, vec3 l, vec3 c) {
     vec3 diffuse;
     if (u_skin_surface) {
-        // Each channel sees a normal softened towards the geometric one.
-        vec3 nl;
-        nl.r = dot(normalize(mix(s.n, s.n_geo, u_normal_softening.r)), l);
-        nl.g = dot(normalize(mix(s.n, s.n_geo, u_normal_softening.g)), l);
-        nl.b = dot(normalize(mix(s.n, s.n_geo, u_normal_softening.b)), l);
-        vec3 u = clamp(0.5 + 0.5 * nl, 0.0, 1.0);
-        diffuse = vec3(texture(u_scatter_table, vec2(u.r, s.curvature)).r,
-                       texture(u_scatter_table, vec2(u.g, s.curvature)).g,
-                       texture(u_scatter_table, vec2(u.b, s.curvature)).b);
-        diffuse *= mix(1.0, s.cavity, u_cavity_direct);
+        vec3 u = clamp(0.5 + 0.5 * vec3(dot(s.n_r, l), dot(s.n_g, l), dot(s.n_b, l)), 0.0, 1.0);
+        diffuse = vec3(textureLod(u_scatter_table, vec2(u.r, s.curvature), 0.0).r,
+                       textureLod(u_scatter_table, vec2(u.g, s.curvature), 0.0).g,
+                       textureLod(u_scatter_table, vec2(u.b, s.curvature), 0.0).b);
+        diffuse *= s.direct_cavity;
     } else {
         diffuse = vec3(max(dot(s.n, l), 0.0));
     }
     // Light that the sheen reflects does not enter the skin.
-    vec3 color = diffuse * s.albedo * s.diffuse_share;
+    vec3 color = diffuse * s.diffuse_albedo;
     float n_dot_l = dot(s.n, l);
     if (n_dot_l > 0.0) {
         vec3 h = normalize(l + s.v);
         float n_dot_h = max(dot(s.n, h), 0.0);
-        float lobes = s.lobe_weight * ggx_dv(s.alpha.x, n_dot_h, n_dot_l, n_dot_v) +
-                      (1.0 - s.lobe_weight) * ggx_dv(s.alpha.y, n_dot_h, n_dot_l, n_dot_v);
+        float lobes = s.lobe_weight * ggx_dv(s.alpha.x, n_dot_h, n_dot_l, s.n_dot_v) +
+                      (1.0 - s.lobe_weight) * ggx_dv(s.alpha.y, n_dot_h, n_dot_l, s.n_dot_v);
         color += vec3(PI * lobes * fresnel(s.f0, dot(l, h)) * n_dot_l);
+    }
+    return color * c;
+}
+
+// Fill and rim (dim lights): a reduced model, one scattering-table lookup
+// at the green channel's softened normal and one GGX lobe.
+vec3 shade_dim(Surface s, vec3 l, vec3 c) {
+    vec3 diffuse;
+    if (u_skin_surface) {
+        float u = clamp(0.5 + 0.5 * dot(s.n_g, l), 0.0, 1.0);
+        diffuse = textureLod(u_scatter_table, vec2(u, s.curvature), 0.0).rgb * s.direct_cavity;
+    } else {
+        diffuse = vec3(max(dot(s.n, l), 0.0));
+    }
+    vec3 color = diffuse * s.diffuse_albedo;
+    float n_dot_l = dot(s.n, l);
+    if (n_dot_l > 0.0) {
+        vec3 h = normalize(l + s.v);
+        float n_dot_h = max(dot(s.n, h), 0.0);
+        float lobe = ggx_dv(s.alpha_mean, n_dot_h, n_dot_l, s.n_dot_v);
+        color += vec3(PI * lobe * fresnel(s.f0, dot(l, h)) * n_dot_l);
     }
     return color * c;
 }
 
 vec3 shade_skin(vec3 n_bumped, vec3 n_geo, vec3 base, float cavity) {
     Surface s;
-    s.n_geo = n_geo;
     s.v = normalize(u_camera_position - v_position);
-    s.albedo = base;
     s.cavity = cavity;
     vec2 roughness;
     if (u_skin_surface) {
@@ -240,6 +259,11 @@ vec3 shade_skin(vec3 n_bumped, vec3 n_geo, vec3 base, float cavity) {
         float dn = length(fwidth(n_geo));
         float dp = length(fwidth(v_position)) * u_mm_per_unit;
         s.curvature = clamp(dn / max(dp, 1e-6) / u_max_curvature, 0.0, 1.0);
+        // Each channel sees a normal softened towards the geometric one;
+        // the same for every light, so made once here.
+        s.n_r = normalize(mix(s.n, n_geo, u_normal_softening.r));
+        s.n_g = normalize(mix(s.n, n_geo, u_normal_softening.g));
+        s.n_b = normalize(mix(s.n, n_geo, u_normal_softening.b));
     } else {
         // Eyes, mouth: one lobe of the roughness matching the Blinn-Phong
         // exponent (Walter et al. 2007: alpha = sqrt(2 / (s + 2))).
@@ -247,29 +271,32 @@ vec3 shade_skin(vec3 n_bumped, vec3 n_geo, vec3 base, float cavity) {
         roughness = vec2(sqrt(alpha));
         s.lobe_weight = 1.0;
         s.n = n_bumped;
+        s.n_r = s.n_g = s.n_b = s.n;
         s.curvature = 0.0;
     }
     s.alpha = max(roughness * roughness, vec2(1e-3));
     // The cavity dims F0 (Jimenez et al. 2013): crevices lose their sheen.
     s.f0 = u_f0 * s.cavity;
-    float n_dot_v = max(dot(s.n, s.v), 1e-4);
+    s.n_dot_v = max(dot(s.n, s.v), 1e-4);
     float mean_roughness = mix(roughness.y, roughness.x, s.lobe_weight);
-    float sheen = environment_brdf(s.f0, mean_roughness, n_dot_v);
-    s.diffuse_share = 1.0 - sheen;
+    s.alpha_mean = max(mean_roughness * mean_roughness, 1e-3);
+    float sheen = environment_brdf(s.f0, mean_roughness, s.n_dot_v);
+    float diffuse_share = 1.0 - sheen;
+    s.diffuse_albedo = base * diffuse_share;
+    s.direct_cavity = mix(1.0, s.cavity, u_cavity_direct);
 
     vec3 key = u_light_position.w == 0.0 ? normalize(u_light_position.xyz)
                                          : normalize(u_light_position.xyz - v_position);
-    vec3 color = shade_light(s, key, u_light_diffuse);
-    color += shade_light(s, normalize(u_fill_direction), u_fill_colour);
-    color += shade_light(s, normalize(u_rim_direction), u_rim_colour);
+    vec3 color = shade_key(s, key, u_light_diffuse);
+    color += shade_dim(s, normalize(u_fill_direction), u_fill_colour);
+    color += shade_dim(s, normalize(u_rim_direction), u_rim_colour);
 
     // The sky/ground hemisphere: diffuse from the softest normal, specular
     // by the environment BRDF towards the reflection, both occluded in the
     // cavity.
-    vec3 ambient_n = u_skin_surface ? normalize(mix(s.n, n_geo, u_normal_softening.r)) : s.n;
-    color += hemisphere(ambient_n) * s.albedo * s.cavity * s.diffuse_share;
+    color += hemisphere(s.n_r) * s.diffuse_albedo * s.cavity;
     color += hemisphere(reflect(-s.v, s.n)) * sheen *
-             specular_occlusion(n_dot_v, s.cavity, mean_roughness);
+             specular_occlusion(s.n_dot_v, s.cavity, mean_roughness);
     return color;
 }
 
