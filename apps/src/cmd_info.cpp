@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "au_label.h"
 #include "command.h"
 #include "emoface/common/error.h"
 #include "emoface/expression/face_state.h"
@@ -165,8 +166,7 @@ emoface::expression::AuIntensities action_units_of(const FapStream& s, const emo
     return out;
 }
 
-// AUs below this are not listed: traces a fit leaves from speech or noise.
-constexpr double kShownAuIntensity = 0.1;
+using emoface::apps::kShownAuIntensity;
 
 nlohmann::json to_json(const std::string& path, const FapStream& s) {
     const Summary sum = summarize(s);
@@ -248,7 +248,7 @@ void add_info_command(CLI::App& root) {
                     all.push_back(j);
                 } else {
                     print_text(path, s);
-                    fmt::print("  AUs       {} ({}; {} and above)\n", aus.to_string(kShownAuIntensity - 1e-9), which,
+                    fmt::print("  AUs       {} ({}; {} and above)\n", emoface::apps::au_label(aus), which,
                                kShownAuIntensity);
                 }
             } catch (const emoface::Error& e) {

@@ -15,6 +15,7 @@
 #include <opencv2/highgui.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "au_label.h"
 #include "command.h"
 #include "emoface/common/error.h"
 #include "emoface/expression/emotion.h"
@@ -38,6 +39,19 @@ struct View {
     bool labels = true;
 };
 
+// `text` cut short with "..." where it is wider than `width` pixels at `scale`
+// (put_label's font and outline), so a title stays inside the picture.
+std::string fit_text(const std::string& text, int width, double scale) {
+    auto fits = [&](const std::string& t) {
+        int baseline = 0;
+        return cv::getTextSize(t, cv::FONT_HERSHEY_SIMPLEX, scale, 3, &baseline).width <= width;
+    };
+    if (fits(text)) return text;
+    std::string cut = text;
+    while (!cut.empty() && !fits(cut + "...")) cut.pop_back();
+    return cut + "...";
+}
+
 // The picture: a title band over [render + overlay | wrinkle map + overlay].
 cv::Mat inspect_picture(Session& session, const expression::FaceState& state, const std::string& title,
                         const View& view) {
@@ -53,11 +67,13 @@ cv::Mat inspect_picture(Session& session, const expression::FaceState& state, co
     draw_feature_overlay(right, layout_pixels(session.layout(), right.cols, right.rows), session.lines(),
                          view.labels);
 
-    const int gap = 6, band = 30;
+    // Two title lines: the title (frame, mix), then the frame's AUs.
+    const int gap = 6, band = 48;
     cv::Mat out(h + band, w + gap + right.cols, CV_8UC3, cv::Scalar(38, 34, 32));
     left.copyTo(out(cv::Rect(0, band, w, h)));
     right.copyTo(out(cv::Rect(w + gap, band, right.cols, h)));
-    put_label(out, title, cv::Point(6, 20), 0.5);
+    put_label(out, fit_text(title, out.cols - 12, 0.5), cv::Point(6, 20), 0.5);
+    put_label(out, fit_text("AUs: " + au_label(state.aus), out.cols - 12, 0.45), cv::Point(6, 40), 0.45);
     const std::string map_caption =
         fmt::format("wrinkle map {}x{} ({})", map.width, map.height, view.raw_map ? "encoded normals" : "lit");
     put_label(out, map_caption, cv::Point(w + gap + 6, band + h - 8), 0.45);

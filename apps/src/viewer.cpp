@@ -39,6 +39,7 @@
 #include "emoface/fap/feature_points.h"
 #include "emoface/render/image_io.h"
 #include "emoface/render/platform.h"
+#include "au_label.h"
 #include "session.h"
 #include "viewer_controls.h"
 
@@ -490,6 +491,8 @@ private:
             playing_ = false;
             dirty_ = true;
         }
+        // The AUs of the face shown (a file's frame, or the sliders' mix).
+        ImGui::TextWrapped("AUs: %s", au_label(state_.aus).c_str());
         if (!mix_error_.empty()) error_wrapped(mix_error_);
     }
 

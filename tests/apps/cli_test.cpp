@@ -249,17 +249,17 @@ TEST_F(AppsCli, InspectWritesRenderAndMapSideBySide) {
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.out.find("84 feature points"), std::string::npos) << r.out;
     const ImageRGBA8 a = emoface::render::read_image_rgba8(path("fap.png"));
-    // Render (200) + gap (6) + map shown at the render's height (160); a 30
-    // pixel title band.
+    // Render (200) + gap (6) + map shown at the render's height (160); a 48
+    // pixel title band (title, then the frame's AUs).
     EXPECT_EQ(a.width, 200 + 6 + 160);
-    EXPECT_EQ(a.height, 160 + 30);
+    EXPECT_EQ(a.height, 160 + 48);
 
     r = run_emoface(
         args_with({"inspect", "--mix", "0.7 anger + 0.3 fear", "--out", path("mix.png"), "--size", "160x160"}, kFast));
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const ImageRGBA8 b = emoface::render::read_image_rgba8(path("mix.png"));
     EXPECT_EQ(b.width, 160 + 6 + 160);
-    EXPECT_EQ(b.height, 160 + 30);
+    EXPECT_EQ(b.height, 160 + 48);
 }
 
 // The OpenCV window (CTest runs this again under xvfb-run): keys step the

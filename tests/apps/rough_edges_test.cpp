@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include "au_label.h"
 #include "label_placement.h"
 #include "session.h"
 #include "sheet.h"
@@ -152,6 +153,35 @@ TEST_F(RoughEdges, InspectPrintsItsStageTimings) {
     EXPECT_NE(r.out.find("per frame, mean of 1:"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("| draw "), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("glFinish"), std::string::npos) << r.out;
+}
+
+// --- the AU line (info, inspect's title, the viewer) --------------------------
+
+TEST(AuLabel, FormatsTheAusShownInInfoInspectAndTheViewer) {
+    using emoface::expression::AuIntensities;
+    struct Case {
+        const char* what;
+        std::vector<std::array<double, 3>> aus;  // number, left, right
+        std::string expected;
+    };
+    const std::vector<Case> cases = {
+        {"empty", {}, "none"},
+        {"all under 0.1", {{4, 0.09, 0.09}, {12, 0.05, 0.0}}, "none"},
+        {"equal sides: one term", {{12, 0.8, 0.8}}, "0.8 AU12"},
+        {"unequal sides: L and R", {{12, 0.8, 0.5}}, "0.8 AU12L + 0.5 AU12R"},
+        {"one side under 0.1", {{6, 0.7, 0.05}}, "0.7 AU6L"},
+        {"0.1 itself is shown", {{1, 0.1, 0.1}}, "0.1 AU1"},
+        {"number order, small ones out", {{26, 1.0, 1.0}, {4, 0.3, 0.3}, {15, 0.02, 0.02}, {1, 1.0, 1.0}},
+         "1 AU1 + 0.3 AU4 + 1 AU26"},
+    };
+    for (const Case& c : cases) {
+        AuIntensities a;
+        for (const auto& [n, l, r] : c.aus) {
+            a.left[std::size_t(n)] = l;
+            a.right[std::size_t(n)] = r;
+        }
+        EXPECT_EQ(emoface::apps::au_label(a), c.expected) << c.what;
+    }
 }
 
 // --- label placement ---------------------------------------------------------
