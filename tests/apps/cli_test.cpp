@@ -275,7 +275,7 @@ TEST_F(AppsCli, InspectWindowStepsWithKeys) {
     EXPECT_EQ(outputs(), std::vector<std::string>{"inspect_11.png"}) << r.out;
     const ImageRGBA8 shot = emoface::render::read_image_rgba8(path("inspect_11.png"));
     EXPECT_EQ(shot.width, 160 + 6 + 160);
-    EXPECT_EQ(shot.height, 160 + 30);
+    EXPECT_EQ(shot.height, 160 + 48);
 }
 
 TEST_F(AppsCli, MorphWritesTheFigureAndTheStageTimes) {

@@ -12,6 +12,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+
+#include <unistd.h>
 #include <memory>
 #include <string>
 
@@ -39,7 +41,12 @@ using render::testing::kFaceTolerance;
 constexpr int kMapSize = 512;
 constexpr int kImageSize = 512;
 // The test head, its painted keys and the last renders, in the build tree.
-constexpr const char* kDir = "anchored-layout-head";
+// One folder per process: ctest runs each test of this suite in its own
+// process, in parallel, and every one builds the head in SetUpTestSuite.
+const std::string& head_dir() {
+    static const std::string dir = "anchored-layout-head-" + std::to_string(::getpid());
+    return dir;
+}
 
 // The UV warp of the test head: monotone on [0, 1] with fixed ends; it
 // widens the middle of the face and squeezes its sides, then places the face
@@ -125,7 +132,7 @@ class AnchoredLayout : public ::testing::Test {
 protected:
     static void SetUpTestSuite() {
         namespace fs = std::filesystem;
-        const std::string dir = kDir;
+        const std::string dir = head_dir();
         fs::remove_all(dir);
         fs::create_directories(dir + "/keys");
         const std::string obj = write_test_head(dir);
@@ -162,6 +169,7 @@ protected:
         scene_ = render::make_face_scene(*platform_, *assets_, so).release();
     }
     static void TearDownTestSuite() {
+        std::filesystem::remove_all(head_dir());
         delete scene_;
         delete platform_;
         delete generated_;
@@ -244,8 +252,9 @@ protected:
         scene_->draw(d);
         platform_->end_frame();
         render::ImageRGBA8 image = platform_->read_rgba();
-        // For a person to look at: the last picture of each kind.
-        render::write_image(std::string(kDir) + "/" + (wrinkles ? "with" : "without") + ".png", image);
+        // The last picture of each kind, to look at while debugging (the
+        // folder goes with the suite's teardown).
+        render::write_image(head_dir() + "/" + (wrinkles ? "with" : "without") + ".png", image);
         return image;
     }
     // The posed position of a feature point's vertex, in pixels of the
