@@ -99,6 +99,33 @@ GLuint link_program(const char* vs_source, const char* fs_source) {
     return p;
 }
 
+// A 2D texture from `texels` (rows first row first, as GL reads them),
+// clamped or repeating, bilinear, with mipmaps when asked.
+struct TextureUpload {
+    GLint internal_format;
+    GLenum format, type;
+    int alignment;  // bytes per row multiple of the texel data
+    bool mipmaps;
+    GLint wrap;
+    const char* what;  // for the GL error check
+};
+GLuint upload_texture(const TextureUpload& u, int width, int height, const void* texels) {
+    GLuint t = 0;
+    glGenTextures(1, &t);
+    glBindTexture(GL_TEXTURE_2D, t);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, u.alignment);
+    glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+    glTexImage2D(GL_TEXTURE_2D, 0, u.internal_format, width, height, 0, u.format, u.type, texels);
+    if (u.mipmaps) glGenerateMipmap(GL_TEXTURE_2D);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, u.mipmaps ? GL_LINEAR_MIPMAP_LINEAR : GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, u.wrap);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, u.wrap);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    check_gl(u.what);
+    return t;
+}
+
 GLuint upload_srgb_texture(const ImageRGBA8& image) {
     if (image.width <= 0 || image.height <= 0 ||
         image.pixels.size() != std::size_t(image.width) * image.height * 4)
@@ -111,21 +138,9 @@ GLuint upload_srgb_texture(const ImageRGBA8& image) {
     for (int y = 0; y < image.height; ++y)
         std::copy_n(image.pixels.data() + std::size_t(image.height - 1 - y) * row, row,
                     flipped.data() + std::size_t(y) * row);
-    GLuint t = 0;
-    glGenTextures(1, &t);
-    glBindTexture(GL_TEXTURE_2D, t);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_SRGB8_ALPHA8, image.width, image.height, 0, GL_RGBA,
-                 GL_UNSIGNED_BYTE, flipped.data());
-    glGenerateMipmap(GL_TEXTURE_2D);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    glBindTexture(GL_TEXTURE_2D, 0);
-    check_gl("uploading a base texture");
-    return t;
+    return upload_texture({GL_SRGB8_ALPHA8, GL_RGBA, GL_UNSIGNED_BYTE, 1, true, GL_CLAMP_TO_EDGE,
+                           "uploading a base texture"},
+                          image.width, image.height, flipped.data());
 }
 
 // The pre-integrated scattering table: clamped, bilinear, RGB half floats.
@@ -134,41 +149,18 @@ constexpr int kScatterTableHeight = 64;   // curvature
 GLuint upload_scatter_table(const SkinShading& skin) {
     const std::vector<float> table =
         detail::preintegrated_scatter_table(skin, kScatterTableWidth, kScatterTableHeight);
-    GLuint t = 0;
-    glGenTextures(1, &t);
-    glBindTexture(GL_TEXTURE_2D, t);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-    glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB16F, kScatterTableWidth, kScatterTableHeight, 0, GL_RGB,
-                 GL_FLOAT, table.data());
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    glBindTexture(GL_TEXTURE_2D, 0);
-    check_gl("uploading the scattering table");
-    return t;
+    return upload_texture({GL_RGB16F, GL_RGB, GL_FLOAT, 4, false, GL_CLAMP_TO_EDGE,
+                           "uploading the scattering table"},
+                          kScatterTableWidth, kScatterTableHeight, table.data());
 }
 
 // The pore map: repeating, mipmapped (filtered pores shorten the normal, which
 // the shader turns into roughness).
 GLuint upload_pore_map(const PoreMapSpec& spec) {
     const std::vector<std::uint8_t> texels = detail::pore_map(spec);
-    GLuint t = 0;
-    glGenTextures(1, &t);
-    glBindTexture(GL_TEXTURE_2D, t);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, spec.size, spec.size, 0, GL_RGBA, GL_UNSIGNED_BYTE,
-                 texels.data());
-    glGenerateMipmap(GL_TEXTURE_2D);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
-    glBindTexture(GL_TEXTURE_2D, 0);
-    check_gl("uploading the pore map");
-    return t;
+    return upload_texture({GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, 1, true, GL_REPEAT,
+                           "uploading the pore map"},
+                          spec.size, spec.size, texels.data());
 }
 
 }  // namespace

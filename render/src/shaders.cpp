@@ -177,16 +177,24 @@ struct Surface {
     float cavity;    // 1 open skin, 0 a deep crevice
 };
 
-// The key light's contribution (colour `c`, direction `l` towards it): the
-// full model, each channel's softened normal looked up in the scattering
-// table, and the two GGX lobes.
-vec3 shade_key(Surface s, vec3 l, vec3 c) {
+// One light's contribution (colour `c`, direction `l` towards it). `full`
+// (a constant at each call, so the compiler drops the other branch): the
+// key light's model, each channel's softened normal looked up in the
+// scattering table and the two GGX lobes. Otherwise the dim lights' (fill,
+// rim) reduced model: one lookup at the green channel's softened normal and
+// one lobe standing for both.
+vec3 shade_light(Surface s, vec3 l, vec3 c, const bool full) {
     vec3 diffuse;
     if (u_skin_surface) {
-        vec3 u = clamp(0.5 + 0.5 * vec3(dot(s.n_r, l), dot(s.n_g, l), dot(s.n_b, l)), 0.0, 1.0);
-        diffuse = vec3(textureLod(u_scatter_table, vec2(u.r, s.curvature), 0.0).r,
-                       textureLod(u_scatter_table, vec2(u.g, s.curvature), 0.0).g,
-                       textureLod(u_scatter_table, vec2(u.b, s.curvature), 0.0).b);
+        if (full) {
+            vec3 u = clamp(0.5 + 0.5 * vec3(dot(s.n_r, l), dot(s.n_g, l), dot(s.n_b, l)), 0.0, 1.0);
+            diffuse = vec3(textureLod(u_scatter_table, vec2(u.r, s.curvature), 0.0).r,
+                           textureLod(u_scatter_table, vec2(u.g, s.curvature), 0.0).g,
+                           textureLod(u_scatter_table, vec2(u.b, s.curvature), 0.0).b);
+        } else {
+            float u = clamp(0.5 + 0.5 * dot(s.n_g, l), 0.0, 1.0);
+            diffuse = textureLod(u_scatter_table, vec2(u, s.curvature), 0.0).rgb;
+        }
         diffuse *= s.direct_cavity;
     } else {
         diffuse = vec3(max(dot(s.n, l), 0.0));
@@ -197,30 +205,10 @@ vec3 shade_key(Surface s, vec3 l, vec3 c) {
     if (n_dot_l > 0.0) {
         vec3 h = normalize(l + s.v);
         float n_dot_h = max(dot(s.n, h), 0.0);
-        float lobes = s.lobe_weight * ggx_dv(s.alpha.x, n_dot_h, n_dot_l, s.n_dot_v) +
-                      (1.0 - s.lobe_weight) * ggx_dv(s.alpha.y, n_dot_h, n_dot_l, s.n_dot_v);
+        float lobes = full ? s.lobe_weight * ggx_dv(s.alpha.x, n_dot_h, n_dot_l, s.n_dot_v) +
+                                 (1.0 - s.lobe_weight) * ggx_dv(s.alpha.y, n_dot_h, n_dot_l, s.n_dot_v)
+                           : ggx_dv(s.alpha_mean, n_dot_h, n_dot_l, s.n_dot_v);
         color += vec3(PI * lobes * fresnel(s.f0, dot(l, h)) * n_dot_l);
-    }
-    return color * c;
-}
-
-// Fill and rim (dim lights): a reduced model, one scattering-table lookup
-// at the green channel's softened normal and one GGX lobe.
-vec3 shade_dim(Surface s, vec3 l, vec3 c) {
-    vec3 diffuse;
-    if (u_skin_surface) {
-        float u = clamp(0.5 + 0.5 * dot(s.n_g, l), 0.0, 1.0);
-        diffuse = textureLod(u_scatter_table, vec2(u, s.curvature), 0.0).rgb * s.direct_cavity;
-    } else {
-        diffuse = vec3(max(dot(s.n, l), 0.0));
-    }
-    vec3 color = diffuse * s.diffuse_albedo;
-    float n_dot_l = dot(s.n, l);
-    if (n_dot_l > 0.0) {
-        vec3 h = normalize(l + s.v);
-        float n_dot_h = max(dot(s.n, h), 0.0);
-        float lobe = ggx_dv(s.alpha_mean, n_dot_h, n_dot_l, s.n_dot_v);
-        color += vec3(PI * lobe * fresnel(s.f0, dot(l, h)) * n_dot_l);
     }
     return color * c;
 }
@@ -287,9 +275,9 @@ vec3 shade_skin(vec3 n_bumped, vec3 n_geo, vec3 base, float cavity) {
 
     vec3 key = u_light_position.w == 0.0 ? normalize(u_light_position.xyz)
                                          : normalize(u_light_position.xyz - v_position);
-    vec3 color = shade_key(s, key, u_light_diffuse);
-    color += shade_dim(s, normalize(u_fill_direction), u_fill_colour);
-    color += shade_dim(s, normalize(u_rim_direction), u_rim_colour);
+    vec3 color = shade_light(s, key, u_light_diffuse, true);
+    color += shade_light(s, normalize(u_fill_direction), u_fill_colour, false);
+    color += shade_light(s, normalize(u_rim_direction), u_rim_colour, false);
 
     // The sky/ground hemisphere: diffuse from the softest normal, specular
     // by the environment BRDF towards the reflection, both occluded in the
