@@ -68,5 +68,37 @@ TEST(ExitCode, EachErrorClassMapsToItsCodeAndLine) {
     }
 }
 
+TEST(EchoInput, EscapesControlsAndCutsLongText) {
+    struct Case {
+        std::string text;
+        std::size_t max;
+        std::string shown;
+    } cases[] = {
+        {"anger", 60, "anger"},
+        {"a\nb\tc\rd", 60, "a\\nb\\tc\\rd"},
+        {"\x1b[31mred", 60, "\\x1b[31mred"},
+        {std::string("nul\0x", 5), 60, "nul\\x00x"},
+        {"caf\xc3\xa9 \xe2\x80\x9cq\xe2\x80\x9d", 60, "caf\xc3\xa9 \xe2\x80\x9cq\xe2\x80\x9d"},  // UTF-8 kept
+        {"bad \xff\xc3(", 60, "bad \\xff\\xc3("},  // not UTF-8: escaped bytes
+        {"\xc2\x85", 60, "\\xc2\\x85"},           // a C1 control
+        {"abcdef", 3, "abc\u2026"},
+        {"\xc3\xa9\xc3\xa9\xc3\xa9", 2, "\xc3\xa9\xc3\xa9\u2026"},  // whole characters
+        {std::string(120000, 'k'), 60, std::string(60, 'k') + "\u2026"},
+    };
+    for (const Case& c : cases) EXPECT_EQ(echo_input(c.text, c.max), c.shown) << c.text.substr(0, 30);
+}
+
+TEST(ErrorLine, IsOneLineOfAtMostTheLimit) {
+    const std::string long_key(5000, 'k');
+    const InputError e("expression: f.json: " + long_key + ": expected a known key, found \"x\"\nsecond line");
+    const std::string line = error_line(e);
+    EXPECT_LE(line.size(), kMaxErrorLine);
+    EXPECT_EQ(line.find('\n'), std::string::npos);
+    EXPECT_EQ(line.rfind("expression: f.json: kkk", 0), 0u) << line;
+    const std::string end = "found \"x\"\\nsecond line";
+    EXPECT_EQ(line.substr(line.size() - end.size()), end) << line;
+    EXPECT_EQ(error_line(InternalError(std::string(1000, 'z'))).size(), kMaxErrorLine);
+}
+
 }  // namespace
 }  // namespace emoface

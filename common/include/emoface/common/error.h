@@ -59,6 +59,16 @@ struct FileLoc {
 [[noreturn]] void fail_data(std::string_view module, const FileLoc& at, std::string_view expected,
                             std::string_view found);
 
+// Untrusted text (a name, a key, a line of a file) as a message quotes it:
+// control characters and bytes that are not UTF-8 escaped (\n, \t, \x1b),
+// cut after `max_chars` characters with "…" added, so an echo never breaks
+// the one-line form or floods the terminal.
+std::string echo_input(std::string_view text, std::size_t max_chars = 60);
+
+// The longest line error_line() returns, in bytes ("emoface: " goes before it;
+// README promises at most 300).
+inline constexpr std::size_t kMaxErrorLine = 290;
+
 enum ExitCode : int { kExitOk = 0, kExitInternal = 1, kExitBadInput = 2, kExitEnvironment = 3 };
 
 // The exit code for an exception that ended a command: InputError (and a
@@ -66,7 +76,9 @@ enum ExitCode : int { kExitOk = 0, kExitInternal = 1, kExitBadInput = 2, kExitEn
 // not an emoface::Error (std::bad_alloc, ...) 1: the program's fault.
 int exit_code(const std::exception& e);
 // The one line a command prints for it (without the program's name):
-// the message, with "this is a bug" for exit code 1.
+// the message, with "this is a bug" for exit code 1; control characters
+// escaped and, past kMaxErrorLine bytes, its middle cut out (a backstop: the
+// messages themselves echo input through echo_input()).
 std::string error_line(const std::exception& e);
 
 }  // namespace emoface
