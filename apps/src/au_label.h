@@ -5,6 +5,8 @@
 #include <string>
 
 #include "emoface/expression/action_units.h"
+#include "emoface/expression/emotion.h"
+#include "emoface/expression/face_state.h"
 
 namespace emoface::apps {
 
@@ -15,5 +17,22 @@ inline constexpr double kShownAuIntensity = 0.1;
 // and above, both sides as one term where they are equal, "L"/"R" terms where
 // they differ; "none" when nothing is left (AuIntensities::to_string).
 std::string au_label(const expression::AuIntensities& aus);
+
+// "0.70 anger + 0.30 fear + 0.3 AU4" (emotions with two decimals, then the
+// mix's own AU terms; "neutral" for none): for labels. parse_emotion_mix
+// reads it back.
+std::string mix_label(const expression::EmotionMix& mix);
+
+// A frame's description in two lines (inspect's title). `where`: the frame
+// ("tour.fap frame 12/49"), "" for a --mix; `given`: the --mix given, if any.
+// Where the emotion mix was derived from the AUs (a frame of low-level FAPs,
+// a --mix with AU terms), the AUs are what the face shows: they come first,
+// and the mix follows labelled as derived (it drives the wrinkles). Else the
+// mix comes first, with its source for a frame, and the AUs second.
+struct FrameTitle {
+    std::string first, second;
+};
+FrameTitle frame_title(const std::string& where, const expression::FaceState& state,
+                       const expression::EmotionMix* given = nullptr);
 
 }  // namespace emoface::apps

@@ -6,7 +6,9 @@
 
 #include <fmt/format.h>
 
+#include "cli_checks.h"
 #include "command.h"
+#include "emoface/common/output_batch.h"
 #include "emoface/common/error.h"
 #include "emoface/expression/default_face.h"
 #include "emoface/expression/face_io.h"
@@ -14,11 +16,6 @@
 namespace {
 
 using namespace emoface::expression;
-
-std::string base_name(const std::string& path) {
-    const auto slash = path.find_last_of('/');
-    return slash == std::string::npos ? path : path.substr(slash + 1);
-}
 
 struct FaceOptions {
     std::string out;
@@ -45,7 +42,16 @@ void add_face_command(CLI::App& root) {
         const std::string suffix = ".obj";
         if (o->out.size() <= suffix.size() || o->out.compare(o->out.size() - suffix.size(), suffix.size(), suffix) != 0)
             emoface::fail<emoface::InputError>("face: --out must name an .obj file, found \"{}\"", o->out);
+        emoface::apps::check_in_range("face", "--resolution", o->resolution, 0.1, 2.0);
+        if (o->texture_size != 0)
+            emoface::apps::check_in_range("face", "--texture-size", o->texture_size, 64, 8192,
+                                          " (0: face.json's)");
         const std::string stem = o->out.substr(0, o->out.size() - suffix.size());
+        // The OBJ, its material, texture and feature points appear together
+        // or not at all; the folder is checked before the face is built.
+        const auto [folder, obj_name] = emoface::apps::split_output_path(o->out, "face", "--out");
+        emoface::OutputBatch batch(folder, "face: --out " + o->out);
+        const std::string name_stem = obj_name.substr(0, obj_name.size() - suffix.size());
         Face face;
         if (!o->candide3.empty()) {
             Candide3Report report;
@@ -62,17 +68,18 @@ void add_face_command(CLI::App& root) {
             options.texture_size = o->texture_size;
             face = make_default_face(o->data + "/face", options);
         }
-        const std::string png = face.base_colour.empty() ? std::string() : stem + ".png";
+        const std::string png = face.base_colour.empty() ? std::string() : name_stem + ".png";
         if (!png.empty()) {
-            save_png(face.base_colour, png);
-            save_mtl(stem + ".mtl", base_name(png));
+            save_png(face.base_colour, batch.stage(png));
+            save_mtl(batch.stage(name_stem + ".mtl"), png);
         }
-        save_obj(face, o->out, png.empty() ? std::string() : base_name(stem + ".mtl"));
-        save_fdp(face, stem + ".fdp.json", base_name(o->out), base_name(png));
+        save_obj(face, batch.stage(obj_name), png.empty() ? std::string() : name_stem + ".mtl");
+        save_fdp(face, batch.stage(name_stem + ".fdp.json"), obj_name, png);
+        batch.commit();
         fmt::print("{}: {} vertices, {} triangles; feature points in {}{}\n", o->out, face.vertex_count(),
                    face.mesh.n_faces(), stem + ".fdp.json",
                    png.empty() ? std::string()
-                               : fmt::format("; base colour {} ({}x{})", png, face.base_colour.width,
+                               : fmt::format("; base colour {} ({}x{})", stem + ".png", face.base_colour.width,
                                              face.base_colour.height));
         fmt::print("FAPU (x1024): IRISD0 {:.2f}  ES0 {:.2f}  ENS0 {:.2f}  MNS0 {:.2f}  MW0 {:.2f}\n",
                    face.fapu.irisd * 1024, face.fapu.es * 1024, face.fapu.ens * 1024, face.fapu.mns * 1024,

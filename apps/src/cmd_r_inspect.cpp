@@ -19,6 +19,7 @@
 #include "command.h"
 #include "emoface/common/error.h"
 #include "emoface/expression/emotion.h"
+#include "emoface/render/image_io.h"
 #include "session.h"
 #include "sheet.h"
 
@@ -31,6 +32,7 @@ struct InspectArgs {
     std::string fap, mix, out, size = "720x720", keys;
     long frame = 0;
     bool raw_map = false, no_labels = false, normalise = false;
+    bool out_given = false;  // if only as ''
     SessionArgs session;
 };
 
@@ -53,7 +55,7 @@ std::string fit_text(const std::string& text, int width, double scale) {
 }
 
 // The picture: a title band over [render + overlay | wrinkle map + overlay].
-cv::Mat inspect_picture(Session& session, const expression::FaceState& state, const std::string& title,
+cv::Mat inspect_picture(Session& session, const expression::FaceState& state, const FrameTitle& title,
                         const View& view) {
     const render::ImageRGBA8 frame = session.render_frame(state);
     const int w = frame.width, h = frame.height;
@@ -67,26 +69,17 @@ cv::Mat inspect_picture(Session& session, const expression::FaceState& state, co
     draw_feature_overlay(right, layout_pixels(session.layout(), right.cols, right.rows), session.lines(),
                          view.labels);
 
-    // Two title lines: the title (frame, mix), then the frame's AUs.
+    // Two title lines (frame_title): what the face shows, then the rest.
     const int gap = 6, band = 48;
     cv::Mat out(h + band, w + gap + right.cols, CV_8UC3, cv::Scalar(38, 34, 32));
     left.copyTo(out(cv::Rect(0, band, w, h)));
     right.copyTo(out(cv::Rect(w + gap, band, right.cols, h)));
-    put_label(out, fit_text(title, out.cols - 12, 0.5), cv::Point(6, 20), 0.5);
-    put_label(out, fit_text("AUs: " + au_label(state.aus), out.cols - 12, 0.45), cv::Point(6, 40), 0.45);
+    put_label(out, fit_text(title.first, out.cols - 12, 0.5), cv::Point(6, 20), 0.5);
+    put_label(out, fit_text(title.second, out.cols - 12, 0.45), cv::Point(6, 40), 0.45);
     const std::string map_caption =
         fmt::format("wrinkle map {}x{} ({})", map.width, map.height, view.raw_map ? "encoded normals" : "lit");
     put_label(out, map_caption, cv::Point(w + gap + 6, band + h - 8), 0.45);
     return out;
-}
-
-// "tour.fap frame 12/49   mix 0.70 anger + 0.30 fear [expression (FAP 2)]"
-// for a frame (where the mix came from in brackets: the source names carry
-// parentheses of their own); "mix 1.00 sadness" for a --mix.
-std::string state_title(const std::optional<std::string>& frame, const expression::FaceState& s) {
-    const std::string mix = "mix " + mix_label(s.mix);
-    if (!frame) return mix;
-    return fmt::format("{}   {} [{}]", *frame, mix, expression::mix_source_name(s.mix_source));
 }
 
 void run_inspect(const InspectArgs& a) {
@@ -104,11 +97,14 @@ void run_inspect(const InspectArgs& a) {
     }
     const auto [width, height] = parse_size(a.size, "inspect");
     const SessionOptions so = a.session.resolve("inspect", width, height);
-    const bool window = a.out.empty();
+    const bool window = !a.out_given;
+    std::optional<OutputFile> output;
     if (window) {
         require_display("inspect", "the window", "give --out overlay.png to write the picture instead");
     } else {
-        check_output_folder(a.out, "inspect");
+        split_output_path(a.out, "inspect", "--out");
+        render::check_image_output(a.out, "inspect: --out " + a.out);
+        output.emplace(a.out, "inspect");
     }
 
     Session session(so);
@@ -121,8 +117,8 @@ void run_inspect(const InspectArgs& a) {
         return stream ? session.face_state(stream->frames[std::size_t(frame)]) : session.face_state(mix);
     };
     auto title_now = [&](const expression::FaceState& s) {
-        if (!stream) return state_title(std::nullopt, s);
-        return state_title(fmt::format("{} frame {}/{}", std::filesystem::path(a.fap).filename().string(), frame,
+        if (!stream) return frame_title("", s, &mix);
+        return frame_title(fmt::format("{} frame {}/{}", std::filesystem::path(a.fap).filename().string(), frame,
                                        stream->frames.size() - 1),
                            s);
     };
@@ -130,7 +126,8 @@ void run_inspect(const InspectArgs& a) {
     if (!window) {
         const auto state = state_now();
         const cv::Mat picture = inspect_picture(session, state, title_now(state), view);
-        write_bgr(a.out, picture);
+        write_bgr(output->path(), picture);
+        output->commit();
         fmt::print("inspect: wrote {} ({}x{}: render | wrinkle map, {} feature points, {} feature lines)\n", a.out,
                    picture.cols, picture.rows,
                    std::count_if(session.feature_points().begin(), session.feature_points().end(),
@@ -188,14 +185,17 @@ void add_inspect_command(CLI::App& root) {
     sub->add_option("--frame", a->frame, "Frame of the FAP file (0-based)")->capture_default_str();
     sub->add_option("--mix", a->mix, "Emotion mix instead of a FAP file, e.g. \"0.7 anger + 0.3 fear\"");
     sub->add_flag("--normalise", a->normalise, "Scale a mix summing over 1 down to 1");
-    sub->add_option("-o,--out", a->out, "Output picture (.png, ...); without it: a window");
+    CLI::Option* out = sub->add_option("-o,--out", a->out, "Output picture (.png, ...); without it: a window");
     sub->add_option("--size", a->size, "Render size WIDTHxHEIGHT (the map is shown HEIGHT square)")
         ->capture_default_str();
     sub->add_flag("--raw-map", a->raw_map, "Show the map's encoded normals instead of lighting it");
     sub->add_flag("--no-labels", a->no_labels, "Dots and lines only");
     sub->add_option("--keys", a->keys, "Window: press these keys first (e.g. \"dDsq\"; for scripts and tests)");
     add_session_options(*sub, a->session);
-    sub->callback([a] { run_inspect(*a); });
+    sub->callback([a, out] {
+        a->out_given = out->count() > 0;
+        run_inspect(*a);
+    });
 }
 
 }  // namespace

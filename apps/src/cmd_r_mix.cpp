@@ -23,6 +23,7 @@ using namespace emoface::apps;
 struct MixArgs {
     std::string mix, out, size;
     bool sheet = false, normalise = false;
+    bool out_given = false, size_given = false;  // given, if only as ''
     SessionArgs session;
     ViewerOptions viewer;  // without --out
 };
@@ -37,23 +38,27 @@ expression::EmotionMix scaled(const expression::EmotionMix& mix, double s) {
 
 void run_mix(const MixArgs& a) {
     const expression::EmotionMix mix = expression::parse_emotion_mix(a.mix, a.normalise);
-    if (a.out.empty()) {
+    const auto size_or = [&](const char* fallback) { return a.size_given ? a.size : std::string(fallback); };
+    if (!a.out_given) {
         // The viewer, its sliders at the mix, with every session option given.
         ViewerOptions v = a.viewer;
         v.command = "mix";
         v.mix = mix.to_string();
-        const auto [width, height] = parse_size(a.size.empty() ? "1280x720" : a.size, "mix");
+        const auto [width, height] = parse_size(size_or("1280x720"), "mix");
         v.session = a.session.resolve("mix", width, height);
         run_viewer(v);
         return;
     }
-    const auto [width, height] = parse_size(a.size.empty() ? (a.sheet ? "320x320" : "720x720") : a.size, "mix");
+    const auto [width, height] = parse_size(size_or(a.sheet ? "320x320" : "720x720"), "mix");
     const SessionOptions so = a.session.resolve("mix", width, height);
-    check_output_folder(a.out, "mix");
+    split_output_path(a.out, "mix", "--out");
+    render::check_image_output(a.out, "mix: --out " + a.out);
+    OutputFile output(a.out, "mix");
     Session session(so);
 
     if (!a.sheet) {
-        render::write_image(a.out, session.render_frame(session.face_state(mix)));
+        render::write_image(output.path(), session.render_frame(session.face_state(mix)));
+        output.commit();
         fmt::print("mix: wrote {} ({}x{}, {}{})\n", a.out, so.picture_width(), height, mix.to_string(),
                    so.wrinkles_note());
     } else {
@@ -63,7 +68,8 @@ void run_mix(const MixArgs& a) {
             row.captions.push_back(fmt::format("intensity {:g}", s));
         }
         const cv::Mat sheet = contact_sheet(fmt::format("{}  at intensity 0 .. 1", mix.to_string()), {row});
-        write_bgr(a.out, sheet);
+        write_bgr(output.path(), sheet);
+        output.commit();
         fmt::print("mix: wrote {} ({}x{}: {} at intensities 0, 0.25, 0.5, 0.75, 1)\n", a.out, sheet.cols,
                    sheet.rows, mix.to_string());
     }
@@ -83,12 +89,16 @@ void add_mix_command(CLI::App& root) {
         sub->add_option("-o,--out", a->out, "Output image (.png, .jpg, .exr, ...); without it: the viewer");
     sub->add_flag("--sheet", a->sheet, "A contact sheet of the mix at intensities 0, 0.25, 0.5, 0.75, 1");
     sub->add_flag("--normalise", a->normalise, "Scale a mix summing over 1 down to 1");
-    sub->add_option("--size", a->size, "Picture (or sheet tile) size WIDTHxHEIGHT (default 720x720; "
+    CLI::Option* size = sub->add_option("--size", a->size, "Picture (or sheet tile) size WIDTHxHEIGHT (default 720x720; "
                                        "320x320 a tile with --sheet; 1280x720 the viewer's window)");
     add_session_options(*sub, a->session);
     add_side_by_side_option(*sub, a->session);
     add_viewer_options(*sub, a->viewer, out);
-    sub->callback([a] { run_mix(*a); });
+    sub->callback([a, out, size] {
+        a->out_given = out->count() > 0;
+        a->size_given = size->count() > 0;
+        run_mix(*a);
+    });
 }
 
 }  // namespace

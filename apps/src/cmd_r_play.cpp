@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <memory>
 #include <string>
 
@@ -13,6 +14,8 @@
 
 #include "command.h"
 #include "emoface/common/error.h"
+#include "emoface/common/output_batch.h"
+#include "emoface/render/image_io.h"
 #include "emoface/render/video_writer.h"
 #include "progress.h"
 #include "session.h"
@@ -26,6 +29,7 @@ using namespace emoface::apps;
 struct PlayArgs {
     std::string fap, out, size = "1280x720", frames;
     double fps = 0;
+    bool fps_given = false;
     SessionArgs session;
     ViewerOptions viewer;  // without --out
 };
@@ -96,6 +100,14 @@ fap::FapFrame frame_at(const fap::FapStream& resolved, double fps, int i) {
 
 // The viewer on the file, with every session option given.
 void run_viewer_for(const PlayArgs& a) {
+    // The viewer plays the whole file at its own rate, scrubbed and paced by
+    // its timeline: options that shape a written animation are refused
+    // rather than silently ignored.
+    if (a.fps_given || !a.frames.empty())
+        fail<InputError>("play: {} shape{} the animation written with --out; the viewer plays the whole file at "
+                         "its own rate (its timeline scrubs and sets the pace)",
+                         a.fps_given && !a.frames.empty() ? "--fps and --frames" : a.fps_given ? "--fps" : "--frames",
+                         a.fps_given && !a.frames.empty() ? "" : "s");
     ViewerOptions v = a.viewer;
     v.command = "play";
     v.fap_path = a.fap;
@@ -104,56 +116,79 @@ void run_viewer_for(const PlayArgs& a) {
     run_viewer(v);
 }
 
+std::string file_name(const std::string& path) { return std::filesystem::path(path).filename().string(); }
+
 void run_play(const PlayArgs& a) {
     // Bad input fails before anything slow happens or is written.
     const fap::FapStream stream = load_fap_stream(a.fap);
-    if (a.fps < 0 || a.fps > 1000) fail<InputError>("play: --fps {}: expected 0 < N <= 1000", a.fps);
+    if (a.fps_given)
+        check_in_range("play", "--fps", a.fps, render::kMinVideoFps, render::kMaxVideoFps, " frames per second");
     if (a.out.empty()) {
         run_viewer_for(a);
         return;
     }
+    const std::string what = "play: --out " + a.out;
     const auto [width, height] = parse_size(a.size, "play");
     const SessionOptions so = a.session.resolve("play", width, height);
     const OutKind kind = output_kind(a.out);
     if (kind == OutKind::Video && (width % 2 || height % 2))
         fail<InputError>("play: --size {}: a video needs an even width and height", a.size);
 
-    const double fps = a.fps > 0 ? a.fps : stream.fps;
-    const int count = a.fps > 0
+    const double fps = a.fps_given ? a.fps : stream.fps;
+    const int count = a.fps_given
                           ? std::max(1, int(std::lround(double(stream.frames.size()) * fps / stream.fps)))
                           : int(stream.frames.size());
     const auto [first, end] = parse_slice(a.frames, count);
-    // Last of the checks: it makes a missing output folder.
-    check_output_folder(a.out, "play");
+
+    std::unique_ptr<render::FrameSequenceWriter> sequence;
+    std::string folder;
+    if (kind == OutKind::Video) {
+        render::VideoWriter::check(a.out, so.picture_width(), height, fps);
+        folder = split_output_path(a.out, "play", "--out").first;
+    } else {
+        sequence = std::make_unique<render::FrameSequenceWriter>(a.out, first);
+        render::check_image_output(sequence->path_for(first), what);
+        folder = std::filesystem::path(sequence->path_for(first)).parent_path().string();
+        // A folder where a frame should go fails now, not after rendering.
+        std::error_code ec;
+        for (int i = first; i < end; ++i)
+            if (std::filesystem::is_directory(sequence->path_for(i), ec))
+                fail<InputError>("{}: frame {} would be {}, which is a folder", what, i, sequence->path_for(i));
+    }
+    // Last of the checks: it makes a missing output folder (removed again
+    // if the command fails) and proves it can be written.
+    OutputBatch batch(folder, what);
     const fap::FapStream resolved = fap::resolve_untransmitted(stream);
 
     Session session(so);
 
     std::unique_ptr<render::VideoWriter> video;
-    std::unique_ptr<render::FrameSequenceWriter> sequence;
-    if (kind == OutKind::Video)
-        video = std::make_unique<render::VideoWriter>(a.out, so.picture_width(), height, fps);
-    else
-        sequence = std::make_unique<render::FrameSequenceWriter>(a.out, first);
+    if (kind == OutKind::Video) {
+        video = std::make_unique<render::VideoWriter>(batch.stage(file_name(a.out)), so.picture_width(), height, fps);
+        // No H.264 here: the writer chose name.avi.
+        if (file_name(video->path()) != file_name(a.out)) batch.stage(file_name(video->path()));
+    }
 
     ProgressBar progress("play", end - first);
     for (int i = first; i < end; ++i) {
         const expression::FaceState state = session.face_state(frame_at(resolved, fps, i));
         const render::ImageRGBA8 image = session.render_frame(state);
         if (video) video->write(image);
-        else sequence->write(image);
+        else render::write_image(batch.stage(file_name(sequence->path_for(i))), image);
         progress.update(i - first + 1);
     }
     progress.finish();
+    if (video) video->close();
+    batch.commit();
 
     const std::string slice =
         (first == 0 && end == count) ? "" : fmt::format(" (frames {}..{} of {})", first, end - 1, count);
     if (video) {
         const std::string codec = video->codec();
-        const std::string path = video->close();
+        const std::string path = batch.destination(file_name(video->path()));
         fmt::print("play: wrote {}: {} frames{} {}x{} at {:g} frames/s, {}{}{}\n", path, end - first, slice,
                    so.picture_width(), height, fps, codec == "H.264" ? "H.264 MP4" : "Motion-JPEG AVI",
-                   so.wrinkles_note(), path != a.out ? " (OpenCV has no H.264 encoder here)" : "");
+                   so.wrinkles_note(), codec != "H.264" && path != a.out ? " (OpenCV has no H.264 encoder here)" : "");
     } else {
         fmt::print("play: wrote {} .. {}: {} frames{} {}x{}{}\n", sequence->path_for(first),
                    sequence->path_for(end - 1), end - first, slice, so.picture_width(), height, so.wrinkles_note());
@@ -173,14 +208,18 @@ void add_play_command(CLI::App& root) {
                     "Video (.mp4: H.264 where OpenCV can, else Motion-JPEG .avi; .avi) or frame "
                     "pattern (frames/%04d.png, numbered by frame). Without it: the viewer");
     sub->add_option("--size", a->size, "Frame size WIDTHxHEIGHT")->capture_default_str();
-    sub->add_option("--fps", a->fps, "Output frame rate (default: the file's); the animation is resampled");
+    CLI::Option* fps = sub->add_option(
+        "--fps", a->fps, "Output frame rate, 0.1..1000 (default: the file's); the animation is resampled");
     sub->add_option("--frames", a->frames,
                     "Render the slice A:B of the output frames, B exclusive (0:50 then 50:107 "
                     "together make 0:107); frame patterns are numbered by frame");
     add_session_options(*sub, a->session);
     add_side_by_side_option(*sub, a->session);
     add_viewer_options(*sub, a->viewer, out);
-    sub->callback([a] { run_play(*a); });
+    sub->callback([a, fps] {
+        a->fps_given = fps->count() > 0;
+        run_play(*a);
+    });
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // emoface: MPEG-4 FAP-driven facial expressions with morphing wrinkles.
 #include <cstdio>
 #include <exception>
+#include <string>
 #include <vector>
 
 #include <spdlog/spdlog.h>
@@ -34,7 +35,16 @@ int main(int argc, char** argv) {
     } catch (const CLI::CallForVersion& e) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
-        app.exit(e);
+        // CLI11's own report is two lines and leaves out the command; ours
+        // is one ("emoface: play: Could not convert: --fps = x (see ...)").
+        std::string command;
+        for (const CLI::App* sub : app.get_subcommands()) command = sub->get_name();
+        std::string what = e.what();
+        for (char& c : what)
+            if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = ' ';
+        if (what.size() > 200) what = what.substr(0, 200) + "...";
+        std::fprintf(stderr, "emoface: %s%s (see emoface %s--help)\n", command.empty() ? "" : (command + ": ").c_str(),
+                     what.c_str(), command.empty() ? "" : (command + " ").c_str());
         return emoface::kExitBadInput;
     } catch (const std::exception& e) {
         // One line; the exit code says whose fault it is (README, "Exit codes").

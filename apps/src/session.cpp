@@ -85,16 +85,6 @@ std::string format_times(const LoadTimes& load, const FrameTimeTotals& frames) {
     return out;
 }
 
-std::string mix_label(const expression::EmotionMix& mix) {
-    std::string out;
-    for (const expression::Emotion e : expression::kEmotions) {
-        const double w = mix[e];
-        if (!(w >= 0.005)) continue;
-        out += fmt::format("{}{:.2f} {}", out.empty() ? "" : " + ", w, expression::emotion_name(e));
-    }
-    return out.empty() ? "neutral" : out;
-}
-
 fap::FapStream load_fap_stream(const std::string& path) {
     if (!std::filesystem::is_regular_file(path))
         fail<InputError>("fap: {}: no such file", path);
@@ -104,42 +94,11 @@ fap::FapStream load_fap_stream(const std::string& path) {
     return stream;
 }
 
-std::pair<int, int> parse_size(const std::string& text, const std::string& command,
-                               const std::string& option) {
-    int w = 0, h = 0;
-    char x = 0, extra = 0;
-    if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X') ||
-        w < 16 || h < 16 || w > 8192 || h > 8192)
-        fail<InputError>("{}: {} '{}': expected WIDTHxHEIGHT, each 16..8192 (e.g. 1280x720)", command,
-                         option, text);
-    return {w, h};
-}
-
 morph::Backend parse_backend(const std::string& text, const std::string& command) {
     if (text == "auto") return morph::Backend::Auto;
     if (text == "cpu") return morph::Backend::Cpu;
     if (text == "cuda") return morph::Backend::Cuda;
     fail<InputError>("{}: --backend '{}': expected auto, cpu or cuda", command, text);
-}
-
-void check_output_folder(const std::string& path, const std::string& command,
-                         const std::string& option) {
-    namespace fs = std::filesystem;
-    if (path.empty()) fail<InputError>("{}: {} is empty", command, option);
-    const fs::path dir = fs::path(path).parent_path();
-    if (dir.empty()) return;
-    std::error_code ec;
-    if (fs::is_directory(dir, ec)) return;
-    // A missing folder is made (as `wrinkles --out` makes its own), so
-    // `--out out/demo.mp4` works in a fresh checkout; a file in the way is
-    // named rather than left to create_directories' generic message.
-    for (fs::path up = dir; !up.empty(); up = up.parent_path()) {
-        if (fs::exists(up, ec) && !fs::is_directory(up, ec))
-            fail<InputError>("{}: {} {}: {} is a file, not a folder", command, option, path, up.string());
-        if (up == up.parent_path()) break;
-    }
-    fs::create_directories(dir, ec);
-    if (ec) fail<InputError>("{}: {} {}: cannot make folder {}: {}", command, option, path, dir.string(), ec.message());
 }
 
 SessionOptions SessionArgs::resolve(const std::string& command, int width, int height) const {
@@ -157,10 +116,8 @@ SessionOptions SessionArgs::resolve(const std::string& command, int width, int h
     render::check_wrinkle_map_size(o.wrinkle_size, command + ": --wrinkle-size");
     if (o.side_by_side && !o.wrinkles)
         fail<InputError>("{}: --side-by-side draws with and without wrinkles: leave out --no-wrinkles", command);
-    if (!(o.face_resolution >= 0.1 && o.face_resolution <= 2.0))
-        fail<InputError>("{}: --face-resolution {}: expected 0.1..2", command, o.face_resolution);
-    if (o.texture_size != 0 && (o.texture_size < 64 || o.texture_size > 8192))
-        fail<InputError>("{}: --texture-size {}: expected 64..8192 (0: face.json's)", command, o.texture_size);
+    check_in_range(command, "--face-resolution", o.face_resolution, 0.1, 2.0);
+    if (o.texture_size != 0) check_in_range(command, "--texture-size", o.texture_size, 64, 8192, " (0: face.json's)");
     return o;
 }
 

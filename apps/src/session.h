@@ -29,6 +29,8 @@
 #include "emoface/render/face_scene.h"
 #include "emoface/render/image.h"
 #include "emoface/render/platform.h"
+#include "au_label.h"
+#include "cli_checks.h"
 
 namespace CLI {
 class App;
@@ -128,28 +130,17 @@ struct FrameTimeTotals {
 // Lines of "stage   mean ms" for a report: loading, then per frame.
 std::string format_times(const LoadTimes& load, const FrameTimeTotals& frames);
 
-// "0.70 anger + 0.30 fear" (two decimals; "neutral" for none): for labels.
-std::string mix_label(const expression::EmotionMix& mix);
 
 // Reads a FAP file for playing; InputError when it has no frames or its
 // frame rate is not positive.
 fap::FapStream load_fap_stream(const std::string& path);
 
-// Parses "WIDTHxHEIGHT" (each 16..8192); InputError starting `command: `.
-std::pair<int, int> parse_size(const std::string& text, const std::string& command,
-                               const std::string& option = "--size");
 // "auto" | "cpu" | "cuda"; InputError otherwise.
 morph::Backend parse_backend(const std::string& text, const std::string& command);
 // Throws EnvironmentError "COMMAND: no display for WHAT (DISPLAY is not
 // set): HEADLESS, or run it ..." when no window can be opened (neither
 // DISPLAY nor WAYLAND_DISPLAY set); `headless` names the way without one.
 void require_display(const std::string& command, const std::string& what, const std::string& headless);
-// Makes `path`'s folder (and its parents) when it is missing; InputError
-// when it cannot be made (a file in the way, no permission). Call it after
-// the other checks and before the slow part, so bad input fails fast and
-// leaves nothing behind.
-void check_output_folder(const std::string& path, const std::string& command,
-                         const std::string& option = "--out");
 
 class Session {
 public:

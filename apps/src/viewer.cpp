@@ -168,6 +168,7 @@ public:
         : options_(options), window_(window), gui_(gui), session_(session), stream_(std::move(stream)) {
         for (expression::Emotion e : expression::kEmotions)
             sliders_[std::size_t(expression::emotion_index(e))] = float(mix[e]);
+        mix_aus_ = mix.aus;
         driven_by_file_ = stream_.has_value() && options.mix.empty();
         playing_ = driven_by_file_;
         wrinkles_ = options.session.wrinkles;
@@ -251,6 +252,7 @@ private:
         // Float rounding of the slider rule can leave the sum a hair over 1.
         const double scale = sum > 1.0 ? 1.0 / sum : 1.0;
         for (std::size_t i = 0; i < sliders_.size(); ++i) mix.weights[i] = double(sliders_[i]) * scale;
+        mix.aus = mix_aus_;
         return mix;
     }
 
@@ -475,7 +477,9 @@ private:
         if (entered) {
             try {
                 const expression::EmotionMix m = expression::parse_emotion_mix(mix_text_, true);
+                session_.face_state(m);  // an AU the face's table lacks is refused here, not mid-frame
                 for (std::size_t i = 0; i < sliders_.size(); ++i) sliders_[i] = float(m.weights[i]);
+                mix_aus_ = m.aus;
                 driven_by_file_ = false;
                 playing_ = false;
                 mix_error_.clear();
@@ -487,6 +491,7 @@ private:
         ImGui::SameLine();
         if (ImGui::Button("neutral")) {
             sliders_.fill(0.0f);
+            mix_aus_ = {};
             driven_by_file_ = false;
             playing_ = false;
             dirty_ = true;
@@ -575,6 +580,9 @@ private:
     expression::FaceState state_;
     std::array<float, 6> sliders_{};
     bool scaled_others_ = false;
+    // The AU terms of the mix given (--mix "0.6 joy + 0.3 AU4") or typed in
+    // the box: shown on top of the sliders' emotions until "neutral".
+    expression::AuIntensities mix_aus_;
     char mix_text_[128] = {};
     bool mix_box_active_ = false;
     std::string mix_error_, backend_error_;
@@ -639,7 +647,12 @@ int run_viewer(const ViewerOptions& options) {
     if (!so.wrinkle_folder.empty() && !std::filesystem::is_directory(so.wrinkle_folder))
         fail<InputError>("{}: --wrinkles {}: no such folder (expected one `emoface wrinkles --out` wrote)", command,
                          so.wrinkle_folder);
-    if (!options.screenshot.empty()) check_output_folder(options.screenshot, command, "--screenshot");
+    std::optional<OutputFile> screenshot;
+    if (!options.screenshot.empty()) {
+        split_output_path(options.screenshot, command, "--screenshot");
+        render::check_image_output(options.screenshot, command + ": --screenshot " + options.screenshot);
+        screenshot.emplace(options.screenshot, command, "--screenshot");
+    }
     if (so.backend == morph::Backend::Cuda && !morph::cuda_available())
         fail<EnvironmentError>("{}: --backend cuda: {} (use --backend cpu or auto)", command,
                                morph::cuda_device_description());
@@ -657,7 +670,8 @@ int run_viewer(const ViewerOptions& options) {
     }
     if (!options.screenshot.empty()) {
         window->make_current();
-        render::write_image(options.screenshot, window->read_rgba());
+        render::write_image(screenshot->path(), window->read_rgba());
+        screenshot->commit();
         std::printf("%s: wrote %s (%dx%d, the window's last frame)\n", command.c_str(), options.screenshot.c_str(),
                     window->width(), window->height());
     }

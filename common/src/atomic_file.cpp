@@ -12,12 +12,13 @@
 #include <fmt/format.h>
 
 #include "emoface/common/error.h"
+#include "emoface/common/output_batch.h"
 
 namespace emoface {
 namespace {
 
 [[noreturn]] void cannot_write(std::string_view module, const std::string& path, int error) {
-    fail_data(module, FileLoc{path, 0, ""}, "a writable file", std::strerror(error));
+    fail_data(module, FileLoc{OutputBatch::shown_path(path), 0, ""}, "a writable file", std::strerror(error));
 }
 
 }  // namespace

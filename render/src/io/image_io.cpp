@@ -3,10 +3,12 @@
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <vector>
 
 #include "emoface/common/atomic_file.h"
 #include "emoface/common/error.h"
+#include "emoface/common/output_batch.h"
 
 namespace emoface::render {
 namespace {
@@ -16,31 +18,43 @@ void check_image(const std::string& path, const Image& image) {
     if (image.width <= 0 || image.height <= 0 ||
         image.pixels.size() != std::size_t(image.width) * image.height * 4)
         fail("render: {}: cannot write a {}x{} image holding {} values (expected width*height*4)",
-             path, image.width, image.height, image.pixels.size());
+             OutputBatch::shown_path(path), image.width, image.height, image.pixels.size());
+}
+
+std::string extension_of(const std::string& path) {
+    const std::string ext = std::filesystem::path(path).extension().string();
+    return ext.empty() ? "none" : "'" + ext + "'";
 }
 
 void write_pixels(const std::string& path, int width, int height, OIIO::TypeDesc in_type,
                   OIIO::TypeDesc file_type, const void* pixels) {
+    const std::string shown = OutputBatch::shown_path(path);
     const std::string temp = temporary_path_for(path);
     auto out = OIIO::ImageOutput::create(path);  // format from the real name
+    OIIO::geterror();  // OpenImageIO keeps its messages per thread: ours are one line
     if (!out)
-        fail<InputError>("render: {}: no image format for this extension ({})", path,
-                         OIIO::geterror());
-    OIIO::ImageSpec spec(width, height, 4, file_type);
+        fail<InputError>("render: {}: expected an image name OpenImageIO writes (.png, .jpg, .tif, .exr, ...), "
+                         "found extension {}",
+                         shown, extension_of(path));
+    // Formats without alpha (JPEG, PNM, ...) get the colour channels: the
+    // pixels are RGBA, every fourth value skipped.
+    const int channels = out->supports("alpha") ? 4 : 3;
+    OIIO::ImageSpec spec(width, height, channels, file_type);
     // Our pixels are straight (unassociated) alpha, written as they are.
     spec.attribute("oiio:UnassociatedAlpha", 1);
     if (!out->open(temp, spec)) {
         const std::string why = out->geterror();
         discard_temporary(temp);
-        fail("render: {}: cannot open for writing: {}", path, why);
+        fail<InputError>("render: {}: cannot write it: {}", shown, why);
     }
-    const bool wrote = out->write_image(in_type, pixels);
+    const OIIO::stride_t pixel_bytes = OIIO::stride_t(4 * in_type.size());
+    const bool wrote = out->write_image(in_type, pixels, pixel_bytes);
     const bool closed = out->close();
     if (!wrote || !closed) {
         const std::string why = out->geterror();
         out.reset();
         discard_temporary(temp);
-        fail("render: {}: writing failed: {}", path, why);
+        fail<InputError>("render: {}: writing failed: {}", shown, why);
     }
     out.reset();
     commit_temporary(temp, path, "render");
@@ -92,6 +106,15 @@ void write_image(const std::string& path, const ImageRGBA32F& image) {
     check_image(path, image);
     write_pixels(path, image.width, image.height, OIIO::TypeDesc::FLOAT, OIIO::TypeDesc::HALF,
                  image.pixels.data());
+}
+
+void check_image_output(const std::string& path, const std::string& what) {
+    auto out = OIIO::ImageOutput::create(path);
+    OIIO::geterror();
+    if (!out)
+        fail<InputError>("{}: expected an image name OpenImageIO writes (.png, .jpg, .tif, .exr, ...), found "
+                         "extension {}",
+                         what, extension_of(path));
 }
 
 ImageRGBA8 read_image_rgba8(const std::string& path) {

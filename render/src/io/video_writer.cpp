@@ -2,15 +2,18 @@
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/core/utils/logger.hpp>
 #include <opencv2/videoio.hpp>
 
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 
 #include "emoface/common/atomic_file.h"
 #include "emoface/common/error.h"
+#include "emoface/common/output_batch.h"
 #include "emoface/render/image_io.h"
 
 namespace emoface::render {
@@ -29,18 +32,40 @@ std::string lower_extension(const std::string& path) {
     return ext;
 }
 
+// OpenCV's and FFmpeg's own logging (tens of lines from libx264 or the
+// container muxer when an open fails) silenced before the first open: a
+// failure is summarised in one line of ours. OpenCV reads
+// OPENCV_FFMPEG_LOGLEVEL when its FFmpeg backend loads; -8 is AV_LOG_QUIET.
+// A value the user set is kept, for debugging.
+void quiet_video_libraries() {
+    static const bool done = [] {
+        ::setenv("OPENCV_FFMPEG_LOGLEVEL", "-8", 0);
+        cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
+        return true;
+    }();
+    (void)done;
+}
+
 }  // namespace
+
+void VideoWriter::check(const std::string& path, int width, int height, double fps) {
+    const std::string shown = OutputBatch::shown_path(path);
+    const std::string ext = lower_extension(path);
+    if (ext != ".mp4" && ext != ".avi")
+        fail<InputError>("render: {}: video output must end in .mp4 or .avi, got '{}'", shown, ext);
+    if (width <= 0 || height <= 0 || width % 2 || height % 2)
+        fail<InputError>("render: {}: video frames must have a positive even size, got {}x{}", shown, width,
+                         height);
+    if (!(fps >= kMinVideoFps && fps <= kMaxVideoFps))
+        fail<InputError>("render: {}: frame rate must be {}..{} frames per second, got {}", shown, kMinVideoFps,
+                         kMaxVideoFps, fps);
+}
 
 VideoWriter::VideoWriter(const std::string& path, int width, int height, double fps)
     : impl_(std::make_unique<Impl>()), path_(path), width_(width), height_(height) {
-    if (width <= 0 || height <= 0 || width % 2 || height % 2)
-        fail<InputError>("render: {}: video frames must have a positive even size, got {}x{}",
-                         path, width, height);
-    if (!(fps > 0.0 && fps <= 1000.0))
-        fail<InputError>("render: {}: frame rate must be in (0, 1000], got {}", path, fps);
+    check(path, width, height, fps);
+    quiet_video_libraries();
     const std::string ext = lower_extension(path);
-    if (ext != ".mp4" && ext != ".avi")
-        fail<InputError>("render: {}: video output must end in .mp4 or .avi, got '{}'", path, ext);
 
     const cv::Size size(width, height);
     if (ext == ".mp4") {
@@ -63,9 +88,9 @@ VideoWriter::VideoWriter(const std::string& path, int width, int height, double 
         return;
     }
     discard_temporary(temp_path_);
-    fail<EnvironmentError>("render: {}: OpenCV's VideoWriter has neither an H.264 nor an MJPG "
-                           "encoder here",
-                           path);
+    fail<EnvironmentError>("render: {}: OpenCV's VideoWriter could open neither an H.264 nor a Motion-JPEG "
+                           "encoder for {}x{} at {:g} frames/s (install OpenCV with FFmpeg support)",
+                           OutputBatch::shown_path(path), width, height, fps);
 }
 
 VideoWriter::~VideoWriter() {
@@ -76,10 +101,10 @@ VideoWriter::~VideoWriter() {
 }
 
 void VideoWriter::write(const ImageRGBA8& frame) {
-    if (!impl_->writer.isOpened()) fail("render: {}: the video is already closed", path_);
+    if (!impl_->writer.isOpened()) fail("render: {}: the video is already closed", OutputBatch::shown_path(path_));
     if (frame.width != width_ || frame.height != height_ ||
         frame.pixels.size() != std::size_t(width_) * height_ * 4)
-        fail("render: {}: frame {} is {}x{}, the video is {}x{}", path_, frames_, frame.width,
+        fail("render: {}: frame {} is {}x{}, the video is {}x{}", OutputBatch::shown_path(path_), frames_, frame.width,
              frame.height, width_, height_);
     const cv::Mat rgba(height_, width_, CV_8UC4, const_cast<std::uint8_t*>(frame.pixels.data()));
     cv::cvtColor(rgba, impl_->bgr, cv::COLOR_RGBA2BGR);
@@ -88,13 +113,13 @@ void VideoWriter::write(const ImageRGBA8& frame) {
 }
 
 std::string VideoWriter::close() {
-    if (!impl_->writer.isOpened()) fail("render: {}: the video is already closed", path_);
+    if (!impl_->writer.isOpened()) fail("render: {}: the video is already closed", OutputBatch::shown_path(path_));
     impl_->writer.release();
     std::error_code ec;
     const auto size = std::filesystem::file_size(temp_path_, ec);
     if (ec || size == 0) {
         discard_temporary(temp_path_);
-        fail("render: {}: the encoder wrote nothing", path_);
+        fail("render: {}: the encoder wrote nothing", OutputBatch::shown_path(path_));
     }
     commit_temporary(temp_path_, path_, "render");
     return path_;
@@ -125,6 +150,12 @@ FrameSequenceWriter::FrameSequenceWriter(std::string pattern, int first_index)
         fail<InputError>("render: frame pattern '{}': needs exactly one %d (like face_%04d.png), "
                          "found {}",
                          pattern_, conversions);
+    // All frames in one folder: the number goes in the file name.
+    if (std::filesystem::path(path_for(0)).parent_path() != std::filesystem::path(path_for(1)).parent_path())
+        fail<InputError>("render: frame pattern '{}': the %d must be in the file name, not in a folder's",
+                         pattern_);
+    if (std::filesystem::path(path_for(0)).filename().empty())
+        fail<InputError>("render: frame pattern '{}': expected a file name after the last '/'", pattern_);
 }
 
 std::string FrameSequenceWriter::path_for(int index) const {

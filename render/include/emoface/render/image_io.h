@@ -15,6 +15,12 @@ void write_image(const std::string& path, const ImageRGBA8& image);
 // extension allows).
 void write_image(const std::string& path, const ImageRGBA32F& image);
 
+// Throws emoface::InputError "<what>: expected an image name OpenImageIO
+// writes ..., found extension '.xyz'" unless an image can be written at
+// `path`: the check a command makes before any slow work. Formats without
+// alpha (.jpg, .ppm, ...) are written as RGB.
+void check_image_output(const std::string& path, const std::string& what);
+
 // Reads any image OpenImageIO knows as RGBA (missing channels: alpha 1, grey
 // replicated). Throws emoface::InputError naming the path on failure.
 ImageRGBA8 read_image_rgba8(const std::string& path);
