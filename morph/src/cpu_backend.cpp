@@ -1,5 +1,6 @@
-// The CPU backend: the key maps copied once, the shared kernel body run over
-// rows on the process's thread pool (emoface/common/parallel.h).
+// The CPU backend: the key maps copied once (each cropped to its region),
+// the shared kernel body run over rows on the process's thread pool
+// (emoface/common/parallel.h).
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
@@ -30,13 +31,22 @@ public:
     CpuBackend(int width, int height, PixelFormat format, const std::vector<KeyMap>& keys)
         : width_(width), height_(height), is_float_(format == PixelFormat::RgbaF32),
           kernels_(pick_kernels()) {
-        const std::size_t bytes = static_cast<std::size_t>(width) * height * (is_float_ ? 16 : 4);
+        const std::size_t pixel = is_float_ ? 16 : 4;
         auto t0 = Clock::now();
         keys_.resize(keys.size());
-        for (auto& k : keys_) k.resize(bytes);
+        for (std::size_t k = 0; k < keys.size(); ++k) {
+            crops_.push_back(key_crop(keys[k].region, width, height));
+            keys_[k].resize(static_cast<std::size_t>(crops_[k].w) * crops_[k].h * pixel);
+        }
         times_.allocate_ms = ms_since(t0);
         t0 = Clock::now();
-        for (std::size_t k = 0; k < keys.size(); ++k) std::memcpy(keys_[k].data(), keys[k].pixels, bytes);
+        for (std::size_t k = 0; k < keys.size(); ++k) {
+            const Crop& c = crops_[k];
+            const auto* src = static_cast<const unsigned char*>(keys[k].pixels);
+            for (int y = 0; y < c.h; ++y)
+                std::memcpy(keys_[k].data() + static_cast<std::size_t>(y) * c.w * pixel,
+                            src + (static_cast<std::size_t>(c.y + y) * width + c.x) * pixel, c.w * pixel);
+        }
         times_.upload_ms = ms_since(t0);
     }
 
@@ -47,9 +57,13 @@ public:
         job.plan = &plan;
         job.width = width_;
         job.height = height_;
-        for (int i = 0; i < plan.sources; ++i)
-            job.keys[i] = {keys_[plan.source_index[i]].data(),
-                           static_cast<std::size_t>(width_) * (is_float_ ? 16 : 4), width_, height_, is_float_};
+        job.is_float = is_float_;
+        for (int i = 0; i < plan.sources; ++i) {
+            const int k = plan.source_index[i];
+            const Crop& c = crops_[k];
+            job.keys[i] = {keys_[k].data(), static_cast<std::size_t>(c.w) * (is_float_ ? 16 : 4), width_, height_,
+                           is_float_, c.x, c.y, c.w, c.h, plan.rest};
+        }
         if (target.kind == OutputTarget::Kind::Positions) {
             job.positions = static_cast<float*>(target.ptr);
         } else {
@@ -66,7 +80,7 @@ public:
         job.grid_w = (width_ - 1) / plan.fast_cell + 2;
         job.grid_h = (height_ - 1) / plan.fast_cell + 2;
         const std::size_t grid_floats =
-            static_cast<std::size_t>(job.grid_w) * job.grid_h * kernel::sum_floats(plan.sources);
+            static_cast<std::size_t>(job.grid_w) * job.grid_h * kernel::sum_floats(plan.sources);  // by slot
         if (grid_.size() < grid_floats) grid_.resize(grid_floats);  // first use / finer cell only
         job.grid = grid_.data();
         parallel_for(job.grid_h, 1, [&](int g0, int g1) { kernels_.grid_rows(job, g0, g1); });
@@ -78,7 +92,8 @@ private:
     int width_, height_;
     bool is_float_;
     const CpuKernels& kernels_;
-    std::vector<std::vector<unsigned char>> keys_;
+    std::vector<std::vector<unsigned char>> keys_;  // crops_[k] of key k
+    std::vector<Crop> crops_;
     std::vector<float> grid_;
     SetupTimes times_;
 };

@@ -1,13 +1,14 @@
 // The CUDA backend: the same kernel body (kernel.h) launched over the image.
 //
-// Setup (once): key maps in pitched device memory with a texture object over
-// each, one stream, and, when the line table is too large to pass as a kernel
+// Setup (once): key maps (each cropped to its region) in pitched device
+// memory with a texture object over each, one stream, and, when the line table is too large to pass as a kernel
 // parameter, a device table. A frame passes the line table as a kernel
 // parameter (up to 8 KB: N = 84 lines with 2 sources fit) or uploads it in
 // by-value slices to the device table, then launches (no host
 // synchronisation, so frames can be captured into a CUDA graph):
 //   exact: warp_kernel over the pixels: lines staged in shared memory, u, v
-//          and the weight once per pixel-line for all sources, hand bilinear
+//          and the weight once per pixel-line for each batch of the sources
+//          whose bound meets the block (kernel.h, "Batches"), hand bilinear
 //          sampling (bit-compatible with the CPU), blend, store.
 //   fast:  warp_kernel over a grid every `fast_cell` pixels writing the
 //          sums of all lines, tile_kernel listing each cell's near lines
@@ -52,9 +53,12 @@ struct LineTable {
 
 enum class OutKind : int { Pixels, Surface, Displacement, Sums };
 
-// Grid sums are padded to whole float4s so a corner loads with 16-byte loads.
+// Grid sums (all the frame's sources, by slot) are padded to whole float4s.
 __host__ __device__ constexpr int sums_stride(int sources) { return (kernel::sum_floats(sources) + 3) / 4 * 4; }
 
+// About 3 KB with kMaxKeys = 32 sources; with the 8 KB line table the
+// launch passes about 11 KB of parameters (CUDA 12.1+ on Volta and newer
+// takes up to 32 KB).
 struct KernelArgs {
     const float4* lines;  // device table, or nullptr: the LineTable parameter
     int n_lines;
@@ -63,12 +67,14 @@ struct KernelArgs {
     int line_split;   // PX = 1 only: threadIdx.y splits the lines of one row, not rows
     float extent, inv_extent, b;
     int points_w, points_h;  // the lattice evaluated by warp_kernel
-    float spacing;           // pixels between lattice points
+    int spacing;             // pixels between lattice points
     int width, height;
-    const unsigned char* key[kMaxKeys];
-    cudaTextureObject_t tex[kMaxKeys];
+    int sources;                            // the frame's sources, by slot:
+    kernel::ImageView key[kMaxKeys];        //   stored pixels (crop) and rest
+    cudaTextureObject_t tex[kMaxKeys];      //   texture over the stored pixels
     float weight[kMaxKeys];
-    std::size_t key_pitch;
+    kernel::Bound bound[kMaxKeys];          //   target pixels where evaluated
+    kernel::Rgba rest;
     int is_float;
     int normal_map;
     OutKind out_kind;
@@ -77,7 +83,7 @@ struct KernelArgs {
     int out_vector;  // out and out_pitch allow 16-byte stores
     cudaSurfaceObject_t surface;
     float2* disp;  // Displacement: [point][source] in pixels
-    float* sums;   // Sums: [point][kernel::sum_floats(K)]
+    float* sums;   // Sums: [point][sums_stride(sources)]
     // Fast mode: grid sums, and per cell its near lines.
     const float* grid;
     int grid_w, cell, tiles_w, tiles_h;
@@ -85,8 +91,12 @@ struct KernelArgs {
     float reach;  // iso units, from a cell's centre
     int* near_count;
     unsigned short* near_list;  // [cell][kernel::kMaxNear]
-    float* tile_sums;           // [cell][4 corners][sums_stride(K)], cells with near lines only
+    float* tile_sums;           // [cell][4 corners][sums_stride(sources)], cells with near lines only
 };
+// The arguments alone within the classic 4 KB; with the line table within
+// the 32764 bytes CUDA 12.1+ allows.
+static_assert(sizeof(KernelArgs) <= 4096, "KernelArgs over 4 KB: keep per-source data small");
+static_assert(sizeof(KernelArgs) + sizeof(LineTable) <= 32764, "kernel parameters over CUDA's limit");
 
 // Copies one 8 KB slice of a line table that is too large to pass by value
 // into the device table. The slice travels as a kernel parameter, so a frame
@@ -114,14 +124,13 @@ __device__ EMOFACE_INLINE void store_pixel(const KernelArgs& a, int x, int y, co
 }
 
 // The fast grid and line table as the kernel body sees them.
-template <int K>
 __device__ EMOFACE_INLINE kernel::FastGrid fast_grid(const KernelArgs& a, const LineTable& table) {
     return {reinterpret_cast<const float*>(a.lines != nullptr ? a.lines : table.rec),
             a.record_floats,
             a.n_lines,
             a.grid,
             a.grid_w,
-            sums_stride(K),
+            sums_stride(a.sources),
             a.cell,
             a.inv_cell,
             a.inv_extent,
@@ -129,17 +138,29 @@ __device__ EMOFACE_INLINE kernel::FastGrid fast_grid(const KernelArgs& a, const 
             a.b};
 }
 
+// The sum of the batch's weights.
+template <int K>
+__device__ EMOFACE_INLINE float batch_weight(const KernelArgs& a, const kernel::Batch<K>& batch) {
+    float w = 0.0f;
+#pragma unroll
+    for (int k = 0; k < K; ++k)
+        if (k < batch.n) w += a.weight[batch.slot[k]];
+    return w;
+}
+
 // One thread sums all lines for PX points of one lattice row. On small
 // lattices (line_split > 1) the threadIdx.y threads of a block share one row
 // instead: each sums every line_split-th line and the partial sums meet in
-// shared memory, so a 256² image still fills the GPU.
+// shared memory, so a 256² image still fills the GPU. The block lists the
+// sources whose bound meets its points and runs the lines once per batch
+// of them (kernel.h, "Batches"); the batches' colours add up per point.
 template <int K, int PX, Law L>
 __global__ void __launch_bounds__(256) warp_kernel(const __grid_constant__ KernelArgs a,
                                                    const __grid_constant__ LineTable table) {
-    constexpr int kRec4 = kernel::record_floats(K) / 4;
     constexpr int S = kernel::sum_floats(K);
     extern __shared__ float4 s_lines[];
     const float4* src = a.lines != nullptr ? a.lines : table.rec;
+    const int rec4 = a.record_floats / 4;
     const int tid = threadIdx.y * blockDim.x + threadIdx.x;
     const int threads = blockDim.x * blockDim.y;
     const bool split = a.line_split > 1;
@@ -147,134 +168,200 @@ __global__ void __launch_bounds__(256) warp_kernel(const __grid_constant__ Kerne
     const int j = split ? blockIdx.y : blockIdx.y * blockDim.y + threadIdx.y;
     const int first_line = split ? threadIdx.y : 0;
     const int line_step = split ? blockDim.y : 1;
+    const bool writes = !split || threadIdx.y == 0;
 
-    Accum<K, PX> acc;
-    acc.clear();
-    const float x0 = (static_cast<float>(i0) * a.spacing + 0.5f) * a.inv_extent;
-    const float y = (static_cast<float>(j) * a.spacing + 0.5f) * a.inv_extent;
-    const float step = a.spacing * a.inv_extent;
-    for (int base = 0; base < a.n_lines; base += a.chunk_lines) {
-        const int count = min(a.chunk_lines, a.n_lines - base);
-        __syncthreads();
-        for (int t = tid; t < count * kRec4; t += threads) s_lines[t] = src[base * kRec4 + t];
-        __syncthreads();
-        for (int l = first_line; l < count; l += line_step) {
-            float4 r4[kRec4];
+    // The block's points in pixels, grown by one lattice step: a grid
+    // point serves the cells on both sides of it.
+    const int bi0 = blockIdx.x * blockDim.x * PX, bi1 = bi0 + blockDim.x * PX;
+    const int bj0 = split ? blockIdx.y : blockIdx.y * blockDim.y, bj1 = split ? bj0 + 1 : bj0 + blockDim.y;
+    const int sp = a.spacing;
+    std::uint32_t mask = kernel::sources_meeting(a.bound, a.sources, (bi0 - 1) * sp, (bj0 - 1) * sp,
+                                                 (bi1 - 1) * sp + sp, (bj1 - 1) * sp + sp);
+
+    const float x0 = (static_cast<float>(i0 * sp) + 0.5f) * a.inv_extent;
+    const float y = (static_cast<float>(j * sp) + 0.5f) * a.inv_extent;
+    const float step = static_cast<float>(sp) * a.inv_extent;
+    kernel::Rgba colour[PX];
 #pragma unroll
-            for (int q = 0; q < kRec4; ++q) r4[q] = s_lines[l * kRec4 + q];
-            kernel::accumulate_line<K, PX, L>(reinterpret_cast<const float*>(r4), x0, y, step, a.b, acc);
+    for (int p = 0; p < PX; ++p) colour[p] = {0.0f, 0.0f, 0.0f, 0.0f};
+    float weight_sum = 0.0f;
+    kernel::Batch<K> batch;
+    while (kernel::take_batch(mask, batch)) {  // the same batches for the whole block
+        Accum<K, PX> acc;
+        acc.clear();
+        for (int base = 0; base < a.n_lines; base += a.chunk_lines) {
+            const int count = min(a.chunk_lines, a.n_lines - base);
+            __syncthreads();
+            for (int t = tid; t < count * rec4; t += threads) s_lines[t] = src[base * rec4 + t];
+            __syncthreads();
+            for (int l = first_line; l < count; l += line_step)
+                kernel::accumulate_line<K, PX, L>(reinterpret_cast<const float*>(s_lines + l * rec4), x0, y, step,
+                                                  a.b, batch, acc);
+        }
+        if (split) {
+            float* partial = reinterpret_cast<float*>(s_lines + a.chunk_lines * rec4);
+            __syncthreads();
+            float* mine = partial + (threadIdx.y * blockDim.x + threadIdx.x) * (S * PX);
+#pragma unroll
+            for (int p = 0; p < PX; ++p) kernel::store_sums(acc, p, mine + p * S);
+            __syncthreads();
+            if (threadIdx.y == 0)
+                for (int g = 1; g < static_cast<int>(blockDim.y); ++g) {
+                    const float* other = partial + (g * blockDim.x + threadIdx.x) * (S * PX);
+#pragma unroll
+                    for (int p = 0; p < PX; ++p) kernel::add_sums(other + p * S, p, acc);
+                }
+        }
+        weight_sum += batch_weight(a, batch);
+        if (!writes || j >= a.points_h) continue;
+#pragma unroll
+        for (int p = 0; p < PX; ++p) {
+            const int i = i0 + p;
+            if (i >= a.points_w) break;
+            if (a.out_kind == OutKind::Sums) {
+                kernel::store_frame_sums(acc, p, batch,
+                                         a.sums + (static_cast<std::size_t>(j) * a.points_w + i) * sums_stride(a.sources));
+                continue;
+            }
+            float dx[K], dy[K];
+            kernel::displacement(acc, p, a.extent, dx, dy);
+            if (a.out_kind == OutKind::Displacement) {
+                float2* d = a.disp + (static_cast<std::size_t>(j) * a.points_w + i) * a.sources;
+#pragma unroll
+                for (int k = 0; k < K; ++k)
+                    if (k < batch.n) d[batch.slot[k]] = make_float2(dx[k], dy[k]);
+                continue;
+            }
+            kernel::blend_batch<K>(a.key, a.weight, batch, static_cast<float>(i) + 0.5f, static_cast<float>(j) + 0.5f,
+                                   dx, dy, colour[p]);
         }
     }
-    if (split) {
-        float* partial = reinterpret_cast<float*>(s_lines + a.chunk_lines * kRec4);
-        __syncthreads();
-        float* mine = partial + (threadIdx.y * blockDim.x + threadIdx.x) * (S * PX);
-#pragma unroll
-        for (int p = 0; p < PX; ++p) kernel::store_sums(acc, p, mine + p * S);
-        __syncthreads();
-        if (threadIdx.y != 0) return;
-        for (int g = 1; g < static_cast<int>(blockDim.y); ++g) {
-            const float* other = partial + (g * blockDim.x + threadIdx.x) * (S * PX);
-#pragma unroll
-            for (int p = 0; p < PX; ++p) kernel::add_sums(other + p * S, p, acc);
-        }
-    }
-    if (j >= a.points_h) return;
-
-    kernel::ImageView keys[K];
-#pragma unroll
-    for (int k = 0; k < K; ++k) keys[k] = {a.key[k], a.key_pitch, a.width, a.height, a.is_float != 0};
+    if (!writes || j >= a.points_h || a.out_kind == OutKind::Sums || a.out_kind == OutKind::Displacement) return;
 #pragma unroll
     for (int p = 0; p < PX; ++p) {
         const int i = i0 + p;
         if (i >= a.points_w) break;
-        float dx[K], dy[K];
-        kernel::displacement(acc, p, a.extent, dx, dy);
-        if (a.out_kind == OutKind::Sums) {
-            kernel::store_sums(acc, p, a.sums + (static_cast<std::size_t>(j) * a.points_w + i) * sums_stride(K));
-            continue;
-        }
-        if (a.out_kind == OutKind::Displacement) {
-            float2* d = a.disp + (static_cast<std::size_t>(j) * a.points_w + i) * K;
-#pragma unroll
-            for (int k = 0; k < K; ++k) d[k] = make_float2(dx[k], dy[k]);
-            continue;
-        }
-        const kernel::Rgba c = kernel::blend_sources<K>(keys, a.weight, static_cast<float>(i) + 0.5f,
-                                                        static_cast<float>(j) + 0.5f, dx, dy, a.normal_map != 0);
-        store_pixel(a, i, j, c);
+        store_pixel(a, i, j, kernel::finish_blend(colour[p], weight_sum, a.rest, a.normal_map != 0, a.is_float != 0));
     }
+}
+
+// The sources whose bound meets cell (tx, ty).
+__device__ EMOFACE_INLINE std::uint32_t cell_sources(const KernelArgs& a, int tx, int ty) {
+    return kernel::sources_meeting(a.bound, a.sources, tx * a.cell, ty * a.cell, tx * a.cell + a.cell,
+                                   ty * a.cell + a.cell);
 }
 
 // Fast mode, pass 2: one thread per cell lists the lines near it and, if
 // there are any (and not too many), writes the cell's four corner sums
-// without them, so pass 3 never recomputes them per pixel.
+// without them for the sources evaluated there, so pass 3 never recomputes
+// them per pixel.
 template <int K, Law L>
 __global__ void __launch_bounds__(128) tile_kernel(const __grid_constant__ KernelArgs a,
                                                    const __grid_constant__ LineTable table) {
-    constexpr int S4 = sums_stride(K);
     const int t = blockIdx.x * blockDim.x + threadIdx.x;
     if (t >= a.tiles_w * a.tiles_h) return;
     const int tx = t % a.tiles_w, ty = t / a.tiles_w;
-    const kernel::FastGrid g = fast_grid<K>(a, table);
+    std::uint32_t mask = cell_sources(a, tx, ty);
+    const kernel::FastGrid g = fast_grid(a, table);
     unsigned short* list = a.near_list + static_cast<std::size_t>(t) * kernel::kMaxNear;
-    const int count = kernel::cell_near_lines(g, tx, ty, list);
+    const int count = mask != 0 ? kernel::cell_near_lines(g, tx, ty, list) : 0;
     a.near_count[t] = count;
     if (count == 0 || count > kernel::kMaxNear) return;
-    kernel::cell_corner_sums<K, L>(g, list, count, tx, ty, a.tile_sums + static_cast<std::size_t>(t) * 4 * S4, S4);
+    const int S4 = sums_stride(a.sources);
+    kernel::Batch<K> batch;
+    while (kernel::take_batch(mask, batch))
+        kernel::cell_corner_sums<K, L>(g, list, count, tx, ty, batch, a.tile_sums + static_cast<std::size_t>(t) * 4 * S4,
+                                       S4);
 }
 
 // Fast mode, pass 3: four pixels of one row a thread, all in one cell
 // (fast_cell is a multiple of 4); a warp covers 32 x 4 pixels, so its loads
-// of grid corners and its texture fetches stay local. The cell's corner sums
-// are interpolated (less the near lines' terms, where it has any), then the
-// near lines are added exactly (kernel.h, "fast mode") and the keys sampled
-// through the texture unit.
+// of grid corners and its texture fetches stay local. Per batch of the
+// sources evaluated in the cell, its corner sums are interpolated (less the
+// near lines' terms, where it has any), then the near lines are added
+// exactly (kernel.h, "fast mode") and the keys sampled: whole keys through
+// the texture unit, cropped ones by hand (rest outside the crop).
 template <int K, Law L>
 __global__ void __launch_bounds__(256, 3) apply_kernel(const __grid_constant__ KernelArgs a,
                                                     const __grid_constant__ LineTable table) {
-    constexpr int S4 = sums_stride(K) / 4;
     const int x0 = (blockIdx.x * blockDim.x + threadIdx.x) * 4;
     const int y = blockIdx.y * blockDim.y + threadIdx.y;
     if (x0 >= a.width || y >= a.height) return;
-    const kernel::FastGrid g = fast_grid<K>(a, table);
+    const kernel::FastGrid g = fast_grid(a, table);
     const int tx = x0 / a.cell, ty = y / a.cell;
     const int tile = ty * a.tiles_w + tx;
+    std::uint32_t mask = cell_sources(a, tx, ty);
     const int count = a.near_count[tile];
     const unsigned short* list = a.near_list + static_cast<std::size_t>(tile) * kernel::kMaxNear;
     const float inv = a.inv_extent;
     const float xi = (static_cast<float>(x0) + 0.5f) * inv, yi = (static_cast<float>(y) + 0.5f) * inv;
     const bool crowded = count > kernel::kMaxNear;  // every line, exactly
-    const float inv_cell = a.inv_cell;
+    const float unit = a.is_float ? 1.0f : 255.0f;
 
-    // The cell's corner sums (from the grid, or from pass 2 where the cell
-    // has near lines), its two columns interpolated to this row.
-    float4 left[S4], right[S4];
-    if (!crowded) {
-        const float fy = static_cast<float>(y - ty * a.cell) * inv_cell;
-        const float4 *c00, *c10, *c01, *c11;
-        if (count == 0) {
-            c00 = reinterpret_cast<const float4*>(a.grid) + (static_cast<std::size_t>(ty) * a.grid_w + tx) * S4;
-            c10 = c00 + S4;
-            c01 = c00 + static_cast<std::size_t>(a.grid_w) * S4;
-            c11 = c01 + S4;
-        } else {
-            c00 = reinterpret_cast<const float4*>(a.tile_sums) + static_cast<std::size_t>(tile) * 4 * S4;
-            c10 = c00 + S4;
-            c01 = c00 + 2 * S4;
-            c11 = c00 + 3 * S4;
-        }
+    // The cell's corner sums: from the grid, or from pass 2 where the cell
+    // has near lines.
+    const int S = sums_stride(a.sources);
+    const float *c00, *c10, *c01, *c11;
+    if (count == 0) {
+        c00 = a.grid + (static_cast<std::size_t>(ty) * a.grid_w + tx) * S;
+        c10 = c00 + S;
+        c01 = c00 + static_cast<std::size_t>(a.grid_w) * S;
+        c11 = c01 + S;
+    } else {
+        c00 = a.tile_sums + static_cast<std::size_t>(tile) * 4 * S;
+        c10 = c00 + S;
+        c01 = c00 + 2 * S;
+        c11 = c00 + 3 * S;
+    }
+    const float fy = static_cast<float>(y - ty * a.cell) * a.inv_cell;
+
+    kernel::Rgba colour[4];
 #pragma unroll
-        for (int q = 0; q < S4; ++q) {
-            const float4 t0 = __ldg(c00 + q), b0 = __ldg(c01 + q), t1 = __ldg(c10 + q), b1 = __ldg(c11 + q);
-            left[q] = make_float4(t0.x + fy * (b0.x - t0.x), t0.y + fy * (b0.y - t0.y), t0.z + fy * (b0.z - t0.z),
-                                  t0.w + fy * (b0.w - t0.w));
-            right[q] = make_float4(t1.x + fy * (b1.x - t1.x), t1.y + fy * (b1.y - t1.y), t1.z + fy * (b1.z - t1.z),
-                                   t1.w + fy * (b1.w - t1.w));
+    for (int p = 0; p < 4; ++p) colour[p] = {0.0f, 0.0f, 0.0f, 0.0f};
+    float weight_sum = 0.0f;
+    kernel::Batch<K> batch;
+    while (kernel::take_batch(mask, batch)) {
+        // The cell's two columns interpolated to this row, for the batch.
+        float left[kernel::sum_floats(K)], right[kernel::sum_floats(K)];
+        if (!crowded) {
+            kernel::cell_row_end(c00, c01, fy, batch, left);
+            kernel::cell_row_end(c10, c11, fy, batch, right);
+        }
+        weight_sum += batch_weight(a, batch);
+#pragma unroll
+        for (int p = 0; p < 4; ++p) {
+            const int x = x0 + p;
+            const float xp = xi + static_cast<float>(p) * inv;
+            Accum<K, 1> acc;
+            kernel::cell_run<K, 1, L>(g, list, count, left, right, x - tx * a.cell, xp, yi, batch, acc);
+            float dx[K], dy[K];
+            kernel::displacement(acc, 0, a.extent, dx, dy);
+            if (a.out_kind == OutKind::Displacement) {
+                if (x < a.width) {
+                    float2* d = a.disp + (static_cast<std::size_t>(y) * a.width + x) * a.sources;
+#pragma unroll
+                    for (int k = 0; k < K; ++k)
+                        if (k < batch.n) d[batch.slot[k]] = make_float2(dx[k], dy[k]);
+                }
+                continue;
+            }
+            const float px = static_cast<float>(x) + 0.5f, py = static_cast<float>(y) + 0.5f;
+#pragma unroll
+            for (int k = 0; k < K; ++k) {
+                if (k >= batch.n) break;
+                const int i = batch.slot[k];
+                const kernel::ImageView& key = a.key[i];
+                if (key.crop_w == a.width && key.crop_h == a.height) {
+                    const float4 t = tex2D<float4>(a.tex[i], px + dx[k], py + dy[k]);
+                    kernel::add_weighted(colour[p], {t.x, t.y, t.z, t.w}, a.weight[i] * unit);
+                } else {
+                    kernel::add_weighted(colour[p], kernel::sample_bilinear(key, px + dx[k], py + dy[k]), a.weight[i]);
+                }
+            }
         }
     }
+    if (a.out_kind == OutKind::Displacement) return;
 
-    const float unit = a.is_float ? 1.0f : 255.0f;
     // RGBA8 into a plain buffer goes out as one 16-byte store per thread;
     // anything else is stored pixel by pixel.
     const bool vector_store = a.out_vector && a.out_kind == OutKind::Pixels && !a.is_float && x0 + 3 < a.width;
@@ -282,32 +369,11 @@ __global__ void __launch_bounds__(256, 3) apply_kernel(const __grid_constant__ K
 #pragma unroll
     for (int p = 0; p < 4; ++p) {
         const int x = x0 + p;
-        const float xp = xi + static_cast<float>(p) * inv;
-        Accum<K, 1> acc;
-        kernel::cell_run<K, 1, L>(g, list, count, reinterpret_cast<const float*>(left),
-                                  reinterpret_cast<const float*>(right), x - tx * a.cell, xp, yi, acc);
-        float dx[K], dy[K];
-        kernel::displacement(acc, 0, a.extent, dx, dy);
-        if (a.out_kind == OutKind::Displacement) {
-            if (x < a.width) {
-                float2* d = a.disp + (static_cast<std::size_t>(y) * a.width + x) * K;
-#pragma unroll
-                for (int k = 0; k < K; ++k) d[k] = make_float2(dx[k], dy[k]);
-            }
-            continue;
-        }
-        const float px = static_cast<float>(x) + 0.5f, py = static_cast<float>(y) + 0.5f;
-        kernel::Rgba sum{0.0f, 0.0f, 0.0f, 0.0f};
-#pragma unroll
-        for (int k = 0; k < K; ++k) {
-            const float4 t = tex2D<float4>(a.tex[k], px + dx[k], py + dy[k]);
-            kernel::add_weighted(sum, {t.x, t.y, t.z, t.w}, a.weight[k] * unit);
-        }
-        if (a.normal_map) sum = kernel::renormalise(sum, unit);
+        const kernel::Rgba c = kernel::finish_blend(colour[p], weight_sum, a.rest, a.normal_map != 0, a.is_float != 0);
         if (vector_store)
-            packed[p] = kernel::pack_rgba8(sum);
+            packed[p] = kernel::pack_rgba8(c);
         else if (x < a.width)
-            store_pixel(a, x, y, sum);
+            store_pixel(a, x, y, c);
     }
     if (vector_store) {
         unsigned char* row = a.out + static_cast<std::size_t>(y) * a.out_pitch;
@@ -321,7 +387,7 @@ __global__ void __launch_bounds__(256, 3) apply_kernel(const __grid_constant__ K
 // constants (std::integral_constant).
 template <class Fn>
 void with_sources_and_law(const FramePlan& plan, Fn&& fn) {
-    kernel::with_sources(plan.sources, [&](auto k) {
+    kernel::with_sources(plan.batch, [&](auto k) {
         if (plan.law == Law::InverseSquare)
             fn(k, std::integral_constant<Law, Law::InverseSquare>{});
         else
@@ -373,13 +439,17 @@ public:
         a.b = plan.b;
         a.width = width_;
         a.height = height_;
-        a.key_pitch = key_pitch_;
         a.is_float = is_float_ ? 1 : 0;
         a.normal_map = plan.normal_map ? 1 : 0;
+        a.sources = plan.sources;
+        a.rest = plan.rest;
         for (int i = 0; i < plan.sources; ++i) {
-            a.key[i] = keys_[plan.source_index[i]];
-            a.tex[i] = textures_[plan.source_index[i]];
+            const int k = plan.source_index[i];
+            const Crop& c = crops_[k];
+            a.key[i] = {keys_[k], key_pitch_[k], width_, height_, is_float_, c.x, c.y, c.w, c.h, plan.rest};
+            a.tex[i] = textures_[k];
             a.weight[i] = plan.weight[i];
+            a.bound[i] = plan.bound[i];
         }
 
         // The line table: by value when it fits, else uploaded to the device
@@ -426,7 +496,7 @@ public:
         if (plan.accuracy == Accuracy::Exact) {
             a.points_w = width_;
             a.points_h = height_;
-            a.spacing = 1.0f;
+            a.spacing = 1;
             launch_points(plan, a, warp_block);
         } else {
             const int cell = plan.fast_cell;
@@ -449,7 +519,7 @@ public:
             KernelArgs g = a;
             g.points_w = a.grid_w;
             g.points_h = grid_h;
-            g.spacing = static_cast<float>(cell);
+            g.spacing = cell;
             g.out_kind = OutKind::Sums;
             g.sums = grid_;
             launch_points(plan, g, warp_block);
@@ -501,7 +571,7 @@ private:
         // point a thread and split the lines of a row over block.y threads.
         KernelArgs a = args;
         const long long points = static_cast<long long>(a.points_w) * a.points_h;
-        const bool few_sources = plan.sources <= 3;
+        const bool few_sources = plan.batch <= 3;
         bool split = split_groups_ > 1 && points < (1 << 20);
         int px = split ? (few_sources ? 2 : 1) : (points >= (1 << 21) && few_sources ? 8 : 4);
         if (px_override_ > 0) {
@@ -515,7 +585,7 @@ private:
         // Shared memory: staged lines, plus the partial sums when splitting;
         // within the 48 KB a block gets without opting in.
         const std::size_t reduce =
-            split ? static_cast<std::size_t>(block.x) * block.y * px * kernel::sum_floats(plan.sources) * sizeof(float)
+            split ? static_cast<std::size_t>(block.x) * block.y * px * kernel::sum_floats(plan.batch) * sizeof(float)
                   : 0;
         const std::size_t record_bytes = static_cast<std::size_t>(plan.record_floats) * sizeof(float);
         a.chunk_lines = static_cast<int>(std::max<std::size_t>(
@@ -563,10 +633,13 @@ private:
         EMOFACE_CUDA_CHECK(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking));
         const std::size_t row = static_cast<std::size_t>(width_) * pixel_bytes_;
         keys_.assign(keys.size(), nullptr);
+        key_pitch_.assign(keys.size(), 0);
         textures_.assign(keys.size(), 0);
         for (std::size_t k = 0; k < keys.size(); ++k) {
+            crops_.push_back(key_crop(keys[k].region, width_, height_));
             void* p = nullptr;
-            EMOFACE_CUDA_CHECK(cudaMallocPitch(&p, &key_pitch_, row, height_));
+            EMOFACE_CUDA_CHECK(
+                cudaMallocPitch(&p, &key_pitch_[k], static_cast<std::size_t>(crops_[k].w) * pixel_bytes_, crops_[k].h));
             keys_[k] = static_cast<unsigned char*>(p);
         }
         // The device line table, for tables that do not fit the parameter.
@@ -580,9 +653,9 @@ private:
             res.res.pitch2D.devPtr = keys_[k];
             res.res.pitch2D.desc =
                 is_float_ ? cudaCreateChannelDesc<float4>() : cudaCreateChannelDesc<uchar4>();
-            res.res.pitch2D.width = width_;
-            res.res.pitch2D.height = height_;
-            res.res.pitch2D.pitchInBytes = key_pitch_;
+            res.res.pitch2D.width = crops_[k].w;
+            res.res.pitch2D.height = crops_[k].h;
+            res.res.pitch2D.pitchInBytes = key_pitch_[k];
             cudaTextureDesc tex{};
             tex.addressMode[0] = cudaAddressModeClamp;
             tex.addressMode[1] = cudaAddressModeClamp;
@@ -595,9 +668,14 @@ private:
         times_.allocate_ms = ms_since(t0);
 
         t0 = Clock::now();
-        for (std::size_t k = 0; k < keys.size(); ++k)
-            EMOFACE_CUDA_CHECK(cudaMemcpy2DAsync(keys_[k], key_pitch_, keys[k].pixels, row, row, height_,
+        for (std::size_t k = 0; k < keys.size(); ++k) {
+            const Crop& c = crops_[k];
+            const auto* first = static_cast<const unsigned char*>(keys[k].pixels) +
+                                (static_cast<std::size_t>(c.y) * width_ + c.x) * pixel_bytes_;
+            EMOFACE_CUDA_CHECK(cudaMemcpy2DAsync(keys_[k], key_pitch_[k], first, row,
+                                                 static_cast<std::size_t>(c.w) * pixel_bytes_, c.h,
                                                  cudaMemcpyHostToDevice, stream_));
+        }
         EMOFACE_CUDA_CHECK(cudaStreamSynchronize(stream_));
         times_.upload_ms = ms_since(t0);
     }
@@ -627,9 +705,10 @@ private:
     int split_groups_ = 4;      // EMOFACE_MORPH_SPLIT=0|2|4|8: threads sharing a row's lines (benchmark)
     int device_ = 0;
     cudaStream_t stream_ = nullptr;
-    std::vector<unsigned char*> keys_;
+    std::vector<unsigned char*> keys_;  // crops_[k] of key k, key_pitch_[k] bytes a row
+    std::vector<std::size_t> key_pitch_;
+    std::vector<Crop> crops_;
     std::vector<cudaTextureObject_t> textures_;
-    std::size_t key_pitch_ = 0;
     float4* lines_ = nullptr;
     float* grid_ = nullptr;
     std::size_t grid_bytes_ = 0;

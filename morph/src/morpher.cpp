@@ -114,6 +114,8 @@ struct Morpher::Impl {
     double sx = 1.0, sy = 1.0;  // normalised -> iso
     double extent = 1.0;        // S
     std::vector<std::vector<IsoLine>> key_lines;
+    std::vector<Region> regions;
+    std::vector<bool> whole;  // the key's region is the whole map
     std::vector<float> records;  // capacity for every key: never grows per frame
     FramePlan plan;
     Backend kind = Backend::Cpu;
@@ -126,6 +128,11 @@ struct Morpher::Impl {
             fail<InputError>("morph: {}(): params.b = {}, expected a value in [0, 16]", fn, params.b);
         if (!(std::isfinite(params.p) && params.p >= 0.0f && params.p <= 16.0f))
             fail<InputError>("morph: {}(): params.p = {}, expected a value in [0, 16]", fn, params.p);
+        for (int c = 0; c < 4; ++c)
+            if (!std::isfinite(params.rest[c]))
+                fail<InputError>("morph: {}(): params.rest[{}] = {}, expected a finite value (format units, "
+                                 "0..1)",
+                                 fn, c, params.rest[c]);
         if (params.accuracy == Accuracy::Fast) {
             const int c = params.fast_cell;
             if (c != 4 && c != 8 && c != 16 && c != 32)
@@ -146,9 +153,10 @@ struct Morpher::Impl {
                 fail<InputError>("morph: {}(): weight {} is {}, expected a finite value >= 0", fn, k, w);
             sum += w;
         }
-        // Rounding of weights that were meant to sum to 1 is not an error.
-        if (sum > 1.0 + 1e-4)
-            fail<InputError>("morph: {}(): weights sum to {}, expected at most 1", fn, sum);
+        // Keys over a rest value add up (MorphParams::rest): up to one full
+        // share per key.
+        if (sum > kMaxKeys + 1e-4)
+            fail<InputError>("morph: {}(): weights sum to {}, expected at most {} (kMaxKeys)", fn, sum, kMaxKeys);
     }
 
     void check_target(const char* fn, const Layout& target) const {
@@ -161,12 +169,16 @@ struct Morpher::Impl {
     // Builds the line table for the given sources. Weights of the sources
     // that take part go to plan.weight in the same order.
     void build_plan(const Layout& target, const MorphParams& params, const int* sources, const float* weights,
-                    int count) {
+                    int count, bool use_regions) {
         plan.sources = count;
+        plan.batch = std::clamp(count, 1, kernel::kMaxBatch);
+        double moved[kMaxKeys] = {};  // largest end point move of each source (iso units)
         for (int i = 0; i < count; ++i) {
             plan.source_index[i] = sources[i];
             plan.weight[i] = weights[i];
         }
+        const float unit = format == PixelFormat::Rgba8 ? 255.0f : 1.0f;
+        plan.rest = {params.rest[0] * unit, params.rest[1] * unit, params.rest[2] * unit, params.rest[3] * unit};
         plan.record_floats = kernel::record_floats(count);
         plan.law = params.b == 2.0f ? kernel::Law::InverseSquare : kernel::Law::Power;
         plan.b = params.b;
@@ -203,6 +215,8 @@ struct Morpher::Impl {
             rec[kernel::kWa] = static_cast<float>(a * wk);
             for (int j = 0; j < count; ++j) {
                 const IsoLine& s = key_lines[sources[j]][i];
+                moved[j] = std::max({moved[j], std::sqrt((s.px - t.px) * (s.px - t.px) + (s.py - t.py) * (s.py - t.py)),
+                                     std::sqrt((s.qx - t.qx) * (s.qx - t.qx) + (s.qy - t.qy) * (s.qy - t.qy))});
                 const double sdx = s.qx - s.px, sdy = s.qy - s.py;
                 const double slen = std::sqrt(sdx * sdx + sdy * sdy);
                 float* c = rec + kernel::kGeomFloats + kernel::kSourceFloats * j;
@@ -216,6 +230,21 @@ struct Morpher::Impl {
         }
         plan.lines = kept;
         plan.records = records.data();
+        for (int j = 0; j < count; ++j)
+            plan.bound[j] = use_regions && !whole[sources[j]] ? region_bound(sources[j], moved[j] * extent)
+                                                              : kernel::Bound{0, 0, width, height};
+    }
+
+    // The target pixels where key k's region can land (morph.h, KeyMap::region):
+    // the pixel positions whose bilinear samples touch its stored texels,
+    // grown by the largest end point move (pixels), a quarter of it and 2
+    // pixels, clipped to the image.
+    kernel::Bound region_bound(int k, double moved) const {
+        const detail::Crop c = detail::key_crop(regions[k], width, height);
+        const double grow = 1.25 * moved + 2.0;
+        auto clip = [](double v, int n) { return static_cast<int>(std::clamp(v, 0.0, static_cast<double>(n))); };
+        return {clip(std::floor(c.x - 0.5 - grow), width), clip(std::floor(c.y - 0.5 - grow), height),
+                clip(std::ceil(c.x + c.w + 0.5 + grow), width), clip(std::ceil(c.y + c.h + 0.5 + grow), height)};
     }
 
     void frame(const char* fn, const Layout& target, const std::vector<float>& weights, const MorphParams& params,
@@ -233,12 +262,7 @@ struct Morpher::Impl {
                 ++count;
             }
         }
-        if (count == 0) {  // a blend of nothing: one source at weight 0 keeps one code path
-            sources[0] = 0;
-            w[0] = 0.0f;
-            count = 1;
-        }
-        build_plan(target, params, sources, w, count);
+        build_plan(target, params, sources, w, count, true);  // no sources: rest everywhere
         backend->run(plan, out);
     }
 };
@@ -252,7 +276,8 @@ Morpher::Morpher(int width, int height, PixelFormat format, std::vector<KeyMap> 
     if (format != PixelFormat::Rgba8 && format != PixelFormat::RgbaF32)
         fail<InputError>("morph: Morpher(): unknown pixel format {}", static_cast<int>(format));
     if (keys.empty() || keys.size() > static_cast<std::size_t>(kMaxKeys))
-        fail<InputError>("morph: Morpher(): K = {} key maps, expected 1 to {}", keys.size(), kMaxKeys);
+        fail<InputError>("morph: Morpher(): K = {} key maps, expected 1 to {} (Morpher::kMaxKeys)", keys.size(),
+                         kMaxKeys);
 
     if (keys[0].layout.size() > static_cast<std::size_t>(kMaxLines))
         fail<InputError>("morph: Morpher(): key 0 layout has {} lines, expected at most {}", keys[0].layout.size(),
@@ -277,6 +302,14 @@ Morpher::Morpher(int width, int height, PixelFormat format, std::vector<KeyMap> 
                              "same line count)",
                              k, key.layout.size(), m.lines);
         check_layout(fn, fmt::format("key {}", k), key.layout, m.sx, m.sy);
+        const Region& r = key.region;
+        if (!(r.x0 >= 0.0f && r.y0 >= 0.0f && r.x1 <= 1.0f && r.y1 <= 1.0f && r.x0 < r.x1 && r.y0 < r.y1))
+            fail<InputError>("morph: Morpher(): key {} region is ({}, {}) - ({}, {}), expected 0 <= x0 < x1 <= 1 and "
+                             "0 <= y0 < y1 <= 1 (normalised coordinates of the key's layout)",
+                             k, r.x0, r.y0, r.x1, r.y1);
+        const detail::Crop crop = detail::key_crop(r, width, height);
+        m.regions.push_back(r);
+        m.whole.push_back(crop.x == 0 && crop.y == 0 && crop.w == width && crop.h == height);
         std::vector<IsoLine> iso;
         iso.reserve(key.layout.size());
         for (const Line& l : key.layout) iso.push_back(to_iso(l, m.sx, m.sy));
@@ -380,7 +413,7 @@ void Morpher::positions_to_host(const Layout& target, const MorphParams& params,
         sources[k] = k;
         w[k] = 1.0f / m.keys;
     }
-    m.build_plan(target, params, sources, w, m.keys);
+    m.build_plan(target, params, sources, w, m.keys, false);
     OutputTarget t;
     t.kind = OutputTarget::Kind::Positions;
     t.ptr = out;

@@ -60,7 +60,16 @@ struct Texel {
     double c[4];
 };
 
-Texel texel(const KeyMap& key, PixelFormat format, int width, int x, int y) {
+// A key is its pixels on the texels its region touches (x from floor(x0 W)
+// to ceil(x1 W), likewise y) and rest everywhere else.
+bool in_region(const KeyMap& key, int width, int height, int x, int y) {
+    const Region& r = key.region;
+    return x >= std::floor(r.x0 * width) && x < std::ceil(r.x1 * width) && y >= std::floor(r.y0 * height) &&
+           y < std::ceil(r.y1 * height);
+}
+
+Texel texel(const KeyMap& key, PixelFormat format, int width, int height, int x, int y, const Texel& rest) {
+    if (!in_region(key, width, height, x, y)) return rest;
     Texel t{};
     const std::size_t i = static_cast<std::size_t>(y) * width + x;
     if (format == PixelFormat::Rgba8) {
@@ -73,14 +82,14 @@ Texel texel(const KeyMap& key, PixelFormat format, int width, int x, int y) {
     return t;
 }
 
-Texel bilinear(const KeyMap& key, PixelFormat format, int width, int height, V2 pos) {
+Texel bilinear(const KeyMap& key, PixelFormat format, int width, int height, V2 pos, const Texel& rest) {
     const double fx = std::clamp(std::isfinite(pos.x) ? pos.x - 0.5 : 0.0, 0.0, width - 1.0);
     const double fy = std::clamp(std::isfinite(pos.y) ? pos.y - 0.5 : 0.0, 0.0, height - 1.0);
     const int x0 = static_cast<int>(std::floor(fx)), y0 = static_cast<int>(std::floor(fy));
     const int x1 = std::min(x0 + 1, width - 1), y1 = std::min(y0 + 1, height - 1);
     const double tx = fx - x0, ty = fy - y0;
-    const Texel a = texel(key, format, width, x0, y0), b = texel(key, format, width, x1, y0);
-    const Texel c = texel(key, format, width, x0, y1), d = texel(key, format, width, x1, y1);
+    const Texel a = texel(key, format, width, height, x0, y0, rest), b = texel(key, format, width, height, x1, y0, rest);
+    const Texel c = texel(key, format, width, height, x0, y1, rest), d = texel(key, format, width, height, x1, y1, rest);
     Texel out{};
     for (int i = 0; i < 4; ++i)
         out.c[i] = (1 - ty) * ((1 - tx) * a.c[i] + tx * b.c[i]) + ty * ((1 - tx) * c.c[i] + tx * d.c[i]);
@@ -110,15 +119,28 @@ void reference_morph(int width, int height, PixelFormat format, const std::vecto
                      const Layout& target, const std::vector<float>& weights, const MorphParams& params, void* out) {
     const Frame f = frame_of(width, height);
     const double unit = format == PixelFormat::Rgba8 ? 255.0 : 1.0;
+    Texel rest{};
+    for (int i = 0; i < 4; ++i) rest.c[i] = params.rest[i] * unit;
+    double weight_sum = 0.0;
+    for (float w : weights) weight_sum += w;
+    // out = Σ w_k key_k + (1 − Σ w) rest, clamped to the format's range where
+    // rest has a share (morph.h, MorphParams::rest).
+    const double share = 1.0 - weight_sum;
+    const bool convex = std::abs(share) <= 1e-5;
     for (int y = 0; y < height; ++y)
         for (int x = 0; x < width; ++x) {
             const V2 X{(x + 0.5) / f.extent, (y + 0.5) / f.extent};
             double c[4] = {0, 0, 0, 0};
             for (std::size_t k = 0; k < keys.size(); ++k) {
                 if (weights[k] <= 0.0f) continue;
-                const Texel t =
-                    bilinear(keys[k], format, width, height, source_position(X, target, keys[k].layout, params, f));
+                const Texel t = bilinear(keys[k], format, width, height,
+                                         source_position(X, target, keys[k].layout, params, f), rest);
                 for (int i = 0; i < 4; ++i) c[i] += weights[k] * t.c[i];
+            }
+            if (!convex) {
+                for (int i = 0; i < 4; ++i) c[i] += share * rest.c[i];
+                if (params.normal_map || format == PixelFormat::Rgba8)
+                    for (double& v : c) v = std::clamp(v, 0.0, unit);
             }
             if (params.normal_map) {
                 double n[3];

@@ -22,14 +22,24 @@
 // pixel-line and then 6 multiply-adds per source. Writing D relative to X keeps
 // float precision where the displacement is small (identity maps give D = 0
 // exactly). The pixel's source position is X + Σ w_i D_i / Σ w_i.
+//
+// Batches. A frame has up to kMaxKeys sources (keys at weight > 0), each with
+// its 6 floats in every line record and a bound: the target pixels where its
+// region can land. A backend takes a block of pixels (a CPU run, a GPU
+// thread block, a fast-mode cell), lists the sources whose bound meets it
+// (sources_meeting), and runs the line loop once per batch of at most
+// kMaxBatch of them (take_batch), whose sums a compile-time K holds in
+// registers. The colours of the batches add up per pixel; finish_blend adds
+// the rest value's share, (1 − Σ w of the sources evaluated) · rest.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <type_traits>
 
 #include "emoface/common/hd.h"
+#include "emoface/morph/limits.h"
 
-// EMOFACE_UNROLL: loops over sources (at most kMaxKeys) and other short
+// EMOFACE_UNROLL: loops over a batch's sources (at most kMaxBatch) and other short
 // compile-time loops, unrolled on both sides. EMOFACE_PIXEL_LOOP: the loop over
 // a run of points, unrolled into registers on the GPU (1 to 8 points) and
 // vectorised on the CPU (64 points; the accumulators are a local that nothing
@@ -47,7 +57,10 @@
 
 namespace emoface::morph::kernel {
 
-inline constexpr int kMaxKeys = 8;
+using morph::kMaxKeys;
+// Sources whose sums one pass of the line loop keeps (the compile-time K).
+inline constexpr int kMaxBatch = 8;
+static_assert(kMaxKeys <= 32, "source masks are 32-bit");
 
 // One line record (floats): the target line's geometry, then 6 floats for each
 // source taking part in the frame; padded to whole float4s so the GPU loads a
@@ -73,13 +86,63 @@ struct Rgba {
     float r, g, b, a;
 };
 
-// A frame's source count (1..kMaxKeys, known at run time) as a compile-time
-// K: calls fn(std::integral_constant<int, K>{}), so the sums of each source
-// live in registers. The one place a backend turns the count into a kernel
-// instantiation (host code).
+// Target pixels [x0, x1) x [y0, y1) where a source is evaluated.
+struct Bound {
+    int x0, y0, x1, y1;
+};
+
+// Bit i set: source i's bound meets pixels [x0, x1) x [y0, y1).
+EMOFACE_HD EMOFACE_INLINE std::uint32_t sources_meeting(const Bound* bounds, int sources, int x0, int y0, int x1,
+                                                        int y1) {
+    std::uint32_t mask = 0;
+    for (int i = 0; i < sources; ++i) {
+        const Bound& b = bounds[i];
+        if (b.x0 < x1 && x0 < b.x1 && b.y0 < y1 && y0 < b.y1) mask |= 1u << i;
+    }
+    return mask;
+}
+
+// Up to K sources of a frame, by their index in the line records (slot);
+// slots past n repeat slot 0 so that every read stays in the record.
+template <int K>
+struct Batch {
+    int n;
+    int slot[K];
+};
+
+EMOFACE_HD EMOFACE_INLINE int lowest_bit(std::uint32_t mask) {
+#if defined(__CUDA_ARCH__)
+    return __ffs(static_cast<int>(mask)) - 1;
+#else
+    return __builtin_ctz(mask);
+#endif
+}
+
+// Moves the lowest (up to) K sources of `mask` into `batch`; false when the
+// mask is empty.
+template <int K>
+EMOFACE_HD EMOFACE_INLINE bool take_batch(std::uint32_t& mask, Batch<K>& batch) {
+    batch.n = 0;
+    EMOFACE_UNROLL
+    for (int k = 0; k < K; ++k) {
+        if (mask != 0) {
+            batch.slot[k] = lowest_bit(mask);
+            mask &= mask - 1;
+            ++batch.n;
+        } else {
+            batch.slot[k] = batch.n > 0 ? batch.slot[0] : 0;
+        }
+    }
+    return batch.n > 0;
+}
+
+// A frame's batch width (min(sources, kMaxBatch), known at run time) as a
+// compile-time K: calls fn(std::integral_constant<int, K>{}), so the sums of
+// each source of a batch live in registers. The one place a backend turns
+// the count into a kernel instantiation (host code).
 template <int K = 1, class Fn>
 void with_sources(int sources, Fn&& fn) {
-    if constexpr (K < kMaxKeys) {
+    if constexpr (K < kMaxBatch) {
         if (sources > K) {
             with_sources<K + 1>(sources, fn);
             return;
@@ -160,11 +223,12 @@ struct Accum {
 };
 
 // Adds one line's contribution to PX points (x0 + j·step, y), j = 0..PX-1,
-// in iso units. `rec` is one line record with K sources. u, v and w are
-// computed once per point and reused for every source.
+// in iso units, for the batch's sources (acc.dx[k] for source batch.slot[k]
+// of the record). u, v and w are computed once per point and reused for
+// every source.
 template <int K, int PX, Law L>
 EMOFACE_HD EMOFACE_INLINE void accumulate_line(const float* rec, float x0, float y, float step,
-                                               float b, Accum<K, PX>& acc) {
+                                               float b, const Batch<K>& batch, Accum<K, PX>& acc) {
     const float ex = rec[kEx], ey = rec[kEy];
     const float nx = rec[kNx], ny = rec[kNy];
     const float half_len = rec[kHalfLen], wk = rec[kWk], wa = rec[kWa];
@@ -198,14 +262,31 @@ EMOFACE_HD EMOFACE_INLINE void accumulate_line(const float* rec, float x0, float
         EMOFACE_PIXEL_LOOP
         for (int j = 0; j < PX; ++j) w[j] = line_weight<L>(w[j], b);
     }
+    if (batch.n == K) {  // a full batch: no test per source
+        EMOFACE_PIXEL_LOOP
+        for (int j = 0; j < PX; ++j) {
+            acc.w[j] += w[j];
+            EMOFACE_UNROLL
+            for (int k = 0; k < K; ++k) {
+                const float* c = src + kSourceFloats * batch.slot[k];
+                acc.dx[k][j] += w[j] * (c[0] + s[j] * c[2] + v[j] * c[4]);
+                acc.dy[k][j] += w[j] * (c[1] + s[j] * c[3] + v[j] * c[5]);
+            }
+        }
+        return;
+    }
     EMOFACE_PIXEL_LOOP
-    for (int j = 0; j < PX; ++j) {
-        acc.w[j] += w[j];
-        EMOFACE_UNROLL
-        for (int k = 0; k < K; ++k) {
-            const float* c = src + kSourceFloats * k;
-            acc.dx[k][j] += w[j] * (c[0] + s[j] * c[2] + v[j] * c[4]);
-            acc.dy[k][j] += w[j] * (c[1] + s[j] * c[3] + v[j] * c[5]);
+    for (int j = 0; j < PX; ++j) acc.w[j] += w[j];
+    // (k < n is uniform over the points: a block's batch)
+    EMOFACE_UNROLL
+    for (int k = 0; k < K; ++k) {
+        if (k >= batch.n) break;
+        const float* c = src + kSourceFloats * batch.slot[k];
+        const float c0 = c[0], c1 = c[1], c2 = c[2], c3 = c[3], c4 = c[4], c5 = c[5];
+        EMOFACE_PIXEL_LOOP
+        for (int j = 0; j < PX; ++j) {
+            acc.dx[k][j] += w[j] * (c0 + s[j] * c2 + v[j] * c4);
+            acc.dy[k][j] += w[j] * (c1 + s[j] * c3 + v[j] * c5);
         }
     }
 }
@@ -292,8 +373,9 @@ EMOFACE_HD EMOFACE_INLINE int cell_near_lines(const FastGrid& g, int tx, int ty,
 }
 
 // Point j's sums: sums[0] = Σw, sums[1 + 2k] = Σ w Dx_k, sums[2 + 2k] = Σ w Dy_k
-// (iso units). store_sums writes them (a grid point, a partial sum), add_sums
-// adds stored ones back.
+// (iso units). store_sums writes them (a partial sum: k the batch's own
+// index), add_sums adds stored ones back; store_frame_sums writes a batch
+// into the sums of all the frame's sources (a grid point: k the source's slot).
 template <int K, int PX>
 EMOFACE_HD EMOFACE_INLINE void store_sums(const Accum<K, PX>& acc, int j, float* sums) {
     sums[0] = acc.w[j];
@@ -312,13 +394,24 @@ EMOFACE_HD EMOFACE_INLINE void add_sums(const float* sums, int j, Accum<K, PX>& 
         acc.dy[k][j] += sums[2 + 2 * k];
     }
 }
+template <int K, int PX>
+EMOFACE_HD EMOFACE_INLINE void store_frame_sums(const Accum<K, PX>& acc, int j, const Batch<K>& batch, float* sums) {
+    sums[0] = acc.w[j];
+    EMOFACE_UNROLL
+    for (int k = 0; k < K; ++k) {
+        if (k >= batch.n) break;
+        sums[1 + 2 * batch.slot[k]] = acc.dx[k][j];
+        sums[2 + 2 * batch.slot[k]] = acc.dy[k][j];
+    }
+}
 
 // One cell before its pixels: the sums of the lines NOT in `list` (its far
 // lines) at its four corners, grid points (tx + (c & 1), ty + (c >> 1)) for
-// c = 0..3, to out + c·out_stride.
+// c = 0..3, for the batch's sources, to out + c·out_stride laid out like the
+// grid (all the frame's sources, by slot).
 template <int K, Law L>
 EMOFACE_HD EMOFACE_INLINE void cell_corner_sums(const FastGrid& g, const unsigned short* list, int count, int tx,
-                                                int ty, float* out, int out_stride) {
+                                                int ty, const Batch<K>& batch, float* out, int out_stride) {
     for (int c = 0; c < 4; ++c) {
         const int gx = tx + (c & 1), gy = ty + (c >> 1);
         const float* all = g.sums + (static_cast<std::size_t>(gy) * g.grid_w + gx) * g.stride;
@@ -326,7 +419,7 @@ EMOFACE_HD EMOFACE_INLINE void cell_corner_sums(const FastGrid& g, const unsigne
         near.clear();
         for (int n = 0; n < count; ++n)
             accumulate_line<K, 1, L>(g.records + list[n] * g.record_floats, grid_coord(gx, g.cell, g.inv_extent),
-                                     grid_coord(gy, g.cell, g.inv_extent), 0.0f, g.b, near);
+                                     grid_coord(gy, g.cell, g.inv_extent), 0.0f, g.b, batch, near);
         // Into registers first: `out` may be global memory that the compiler
         // cannot prove apart from the grid, and a store before each load
         // would serialise them.
@@ -334,25 +427,54 @@ EMOFACE_HD EMOFACE_INLINE void cell_corner_sums(const FastGrid& g, const unsigne
         far[0] = all[0] - near.w[0];
         EMOFACE_UNROLL
         for (int k = 0; k < K; ++k) {
-            far[1 + 2 * k] = all[1 + 2 * k] - near.dx[k][0];
-            far[2 + 2 * k] = all[2 + 2 * k] - near.dy[k][0];
+            const bool used = k < batch.n;
+            far[1 + 2 * k] = used ? all[1 + 2 * batch.slot[k]] - near.dx[k][0] : 0.0f;
+            far[2 + 2 * k] = used ? all[2 + 2 * batch.slot[k]] - near.dy[k][0] : 0.0f;
         }
-        for (int q = 0; q < sum_floats(K); ++q) out[c * out_stride + q] = far[q];
+        float* o = out + c * out_stride;
+        o[0] = far[0];
+        EMOFACE_UNROLL
+        for (int k = 0; k < K; ++k) {
+            if (k >= batch.n) break;
+            o[1 + 2 * batch.slot[k]] = far[1 + 2 * k];
+            o[2 + 2 * batch.slot[k]] = far[2 + 2 * k];
+        }
+    }
+}
+
+// A cell row's ends for the batch: the corner sums `top` and `bottom`
+// (grid layout, by slot) interpolated to fraction fy of the cell, into
+// `row` (the batch's own layout, sum_floats(K) floats; 0 past n).
+template <int K>
+EMOFACE_HD EMOFACE_INLINE void cell_row_end(const float* top, const float* bottom, float fy, const Batch<K>& batch,
+                                            float* row) {
+    row[0] = top[0] + fy * (bottom[0] - top[0]);
+    EMOFACE_UNROLL
+    for (int k = 0; k < K; ++k) {
+        if (k < batch.n) {
+            const int x = 1 + 2 * batch.slot[k], y = 2 + 2 * batch.slot[k];
+            row[1 + 2 * k] = top[x] + fy * (bottom[x] - top[x]);
+            row[2 + 2 * k] = top[y] + fy * (bottom[y] - top[y]);
+        } else {
+            row[1 + 2 * k] = 0.0f;
+            row[2 + 2 * k] = 0.0f;
+        }
     }
 }
 
 // One run of R neighbouring pixels of a cell row, the first at column i0 of
 // its cell and at (x, y) iso units: the far sums interpolated between the
 // row's `left` and `right` ends (the cell's corner sums already interpolated
-// to this row), plus the near lines exactly; a crowded cell (count >
-// kMaxNear) sums every line exactly.
+// to this row, the batch's layout), plus the near lines exactly; a crowded
+// cell (count > kMaxNear) sums every line exactly.
 template <int K, int R, Law L>
 EMOFACE_HD EMOFACE_INLINE void cell_run(const FastGrid& g, const unsigned short* list, int count, const float* left,
-                                        const float* right, int i0, float x, float y, Accum<K, R>& acc) {
+                                        const float* right, int i0, float x, float y, const Batch<K>& batch,
+                                        Accum<K, R>& acc) {
     if (count > kMaxNear) {
         acc.clear();
         for (int l = 0; l < g.lines; ++l)
-            accumulate_line<K, R, L>(g.records + l * g.record_floats, x, y, g.inv_extent, g.b, acc);
+            accumulate_line<K, R, L>(g.records + l * g.record_floats, x, y, g.inv_extent, g.b, batch, acc);
         return;
     }
     EMOFACE_PIXEL_LOOP
@@ -366,21 +488,35 @@ EMOFACE_HD EMOFACE_INLINE void cell_run(const FastGrid& g, const unsigned short*
         }
     }
     for (int n = 0; n < count; ++n)
-        accumulate_line<K, R, L>(g.records + list[n] * g.record_floats, x, y, g.inv_extent, g.b, acc);
+        accumulate_line<K, R, L>(g.records + list[n] * g.record_floats, x, y, g.inv_extent, g.b, batch, acc);
 }
 
 // ---- sampling and blending --------------------------------------------------
 
 // A key map in memory: rows of `pitch` bytes, RGBA8 (4 bytes a pixel) or
-// RGBA float (16 bytes a pixel).
+// RGBA float (16 bytes a pixel), width x height pixels as the target sees
+// them, of which only the crop [crop_x, crop_x + crop_w) x [crop_y, crop_y +
+// crop_h) is stored (`base` is its first pixel); texels outside it read as
+// `rest` (format units). A key without a region is stored whole.
 struct ImageView {
     const unsigned char* base;
     std::size_t pitch;
     int width, height;
     bool is_float;
+    int crop_x, crop_y, crop_w, crop_h;
+    Rgba rest;
 };
 
+EMOFACE_HD EMOFACE_INLINE bool in_crop(const ImageView& img, int x, int y) {
+    return static_cast<unsigned>(x - img.crop_x) < static_cast<unsigned>(img.crop_w) &&
+           static_cast<unsigned>(y - img.crop_y) < static_cast<unsigned>(img.crop_h);
+}
+
+// Texel (x, y) of the whole map (0 <= x < width, 0 <= y < height).
 EMOFACE_HD EMOFACE_INLINE Rgba load_texel(const ImageView& img, int x, int y) {
+    if (!in_crop(img, x, y)) return img.rest;
+    x -= img.crop_x;
+    y -= img.crop_y;
     const unsigned char* row = img.base + static_cast<std::size_t>(y) * img.pitch;
     if (img.is_float) {
         const float* p = reinterpret_cast<const float*>(row) + 4 * x;
@@ -453,15 +589,43 @@ EMOFACE_HD EMOFACE_INLINE std::uint32_t pack_rgba8(const Rgba& c) {
            (static_cast<std::uint32_t>(to_byte(c.a)) << 24);
 }
 
-// Samples the K sources at X + D_k and blends them by weight: the per-pixel
-// end of the kernel, after the line loop.
+// Samples the batch's sources at X + D_k and adds them by weight to `sum`
+// (keys and weights indexed by slot): the per-pixel end of a batch, after
+// the line loop.
 template <int K>
-EMOFACE_HD EMOFACE_INLINE Rgba blend_sources(const ImageView* keys, const float* weights, float px, float py, const float (&dx)[K],
-                                             const float (&dy)[K], bool normal_map) {
-    Rgba sum{0.0f, 0.0f, 0.0f, 0.0f};
+EMOFACE_HD EMOFACE_INLINE void blend_batch(const ImageView* keys, const float* weights, const Batch<K>& batch, float px,
+                                           float py, const float (&dx)[K], const float (&dy)[K], Rgba& sum) {
     EMOFACE_UNROLL
-    for (int k = 0; k < K; ++k) add_weighted(sum, sample_bilinear(keys[k], px + dx[k], py + dy[k]), weights[k]);
-    if (normal_map) sum = renormalise(sum, keys[0].is_float ? 1.0f : 255.0f);
+    for (int k = 0; k < K; ++k) {
+        if (k >= batch.n) break;
+        const int i = batch.slot[k];
+        add_weighted(sum, sample_bilinear(keys[i], px + dx[k], py + dy[k]), weights[i]);
+    }
+}
+
+// Below this |1 − Σw| the blend is convex and rest is left out, so weights
+// meant to sum to 1 give the plain blend to the last bit, whatever rest is.
+inline constexpr float kConvexSlack = 1e-5f;
+
+// The per-pixel end of the kernel: `sum` = Σ w_k key_k over the sources
+// evaluated here, whose weights sum to `weight_sum`. Adds (1 − weight_sum)
+// · rest (format units); where that share is not 0, clamps to the format's
+// range ([0, unit]; RgbaF32 colour keeps its values) since keys added over
+// rest can overshoot it; renormalises a normal map.
+EMOFACE_HD EMOFACE_INLINE Rgba finish_blend(Rgba sum, float weight_sum, const Rgba& rest, bool normal_map,
+                                            bool is_float) {
+    const float unit = is_float ? 1.0f : 255.0f;
+    const float share = 1.0f - weight_sum;
+    if (absf(share) > kConvexSlack) {
+        add_weighted(sum, rest, share);
+        if (normal_map || !is_float) {
+            sum.r = clampf(sum.r, 0.0f, unit);
+            sum.g = clampf(sum.g, 0.0f, unit);
+            sum.b = clampf(sum.b, 0.0f, unit);
+            sum.a = clampf(sum.a, 0.0f, unit);
+        }
+    }
+    if (normal_map) sum = renormalise(sum, unit);
     return sum;
 }
 

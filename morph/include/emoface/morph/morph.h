@@ -2,7 +2,14 @@
 // morph: Beier-Neely multi-source warp and blend (DESIGN.md "Beier-Neely
 // warp", thesis 3.2 and 5). Knows nothing of faces: K key images, each with a
 // layout of N feature lines, are warped onto a target layout and blended by
-// K weights:  out = Σ_k w_k · warp(key_k, layout_k -> target).
+// K weights over a rest value:
+//   out = Σ_k w_k · warp(key_k, layout_k -> target) + (1 − Σ_k w_k) · rest.
+// Weights summing to 1 are the thesis's convex blend (rest drops out). Keys
+// that are deviations from a rest state (per-Action-Unit wrinkles over flat
+// skin) take weights summing to more than 1: each adds w_k · (key_k − rest).
+// A key may declare a region (KeyMap::region) outside which it equals rest;
+// it is stored cropped and evaluated only where its region lands in the
+// target, so small keys cost about their size.
 //
 // Coordinates. Line end points are normalised texture coordinates: x = 0 at
 // the left edge and 1 at the right edge of the image, y = 0 at the top edge
@@ -16,11 +23,17 @@
 // thesis's steps 1 and 2); a frame validates the target layout and weights,
 // builds the line table (N records) and runs one pass (exact) or two
 // (fast), allocating nothing (buffers that only some calls need, such as the
-// fast mode's displacement grid, are allocated at their first use).
+// fast mode's displacement grid, are allocated at their first use). A key at
+// weight 0 is neither warped nor sampled; the kernel keeps the sums of at
+// most 8 keys at once and runs its line loop once per 8 keys that overlap a
+// block of pixels.
 #include <cstddef>
 #include <memory>
 #include <string>
+#include <array>
 #include <vector>
+
+#include "emoface/morph/limits.h"
 
 namespace emoface::morph {
 
@@ -60,6 +73,24 @@ struct MorphParams {
     // error of the interpolated part falls as 1 / fast_reach²).
     int fast_cell = 8;
     float fast_reach = 4.0f;
+    // What the blend tends to where keys say nothing: the value a key has
+    // outside its region, and the (1 − Σ w) share of every pixel. RGBA in
+    // [0, 1] units of the format (Rgba8: 1 = 255). Normal maps of wrinkles
+    // pass flat skin {0.5, 0.5, 1, 1}: slopes of overlapping keys then add,
+    // and alpha (1 = open skin) becomes 1 + Σ w (a_k − 1). The blend is
+    // clamped to the format's range ([0, 1] for normal maps, [0, 255] for
+    // Rgba8) before a normal map is renormalised and stored. Pick a value
+    // the format holds exactly (Rgba8: a multiple of 1/255) if the keys'
+    // rest pixels must cancel to the last bit. When the weights of the keys
+    // evaluated at a pixel sum to 1 (within 1e-5) rest is not added at all, so
+    // the convex blend is bit-identical with any rest.
+    std::array<float, 4> rest{0.0f, 0.0f, 0.0f, 0.0f};
+};
+
+// A rectangle in normalised coordinates of a key's own layout (see above:
+// x right, y down, 0..1 across the map), x0 < x1, y0 < y1.
+struct Region {
+    float x0 = 0.0f, y0 = 0.0f, x1 = 1.0f, y1 = 1.0f;
 };
 
 struct KeyMap {
@@ -71,6 +102,17 @@ struct KeyMap {
     // 0 means "the Morpher's size".
     int width = 0;
     int height = 0;
+    // Where the key differs from MorphParams::rest; outside it the key IS
+    // rest, whatever its pixels hold there. The Morpher keeps only the pixels
+    // the region touches, and evaluates the key per frame only for target
+    // pixels within a bound of where the region lands: the region's
+    // rectangle grown by the largest displacement of any line end point
+    // between the key's layout and the target, by a quarter of that again and
+    // by 2 pixels. Beier-Neely moves a pixel by a weighted mean of what its
+    // lines do at its position, which can exceed their end points' moves
+    // where lines rotate or stretch far from the pixel; the margin covers
+    // that for layouts whose lines move together (faces), it is not a proof.
+    Region region;
 };
 
 // What the constructor spent on the thesis's steps 1 (allocate) and 2 (upload).
@@ -91,13 +133,14 @@ const char* cpu_kernels_name();
 
 class Morpher {
 public:
-    static constexpr int kMaxKeys = 8;
+    static constexpr int kMaxKeys = morph::kMaxKeys;
     static constexpr int kMaxSide = 16384;
     static constexpr int kMaxLines = 4096;
 
     // Throws emoface::InputError for bad keys (count 0 or over kMaxKeys, null
     // pixels, sizes that differ, layouts with different line counts or over
-    // kMaxLines lines, a line of zero length or with a non-finite coordinate) and emoface::EnvironmentError
+    // kMaxLines lines, a line of zero length or with a non-finite coordinate,
+    // a region that is not a non-empty rectangle within [0, 1]²) and emoface::EnvironmentError
     // for Backend::Cuda where no device is usable. Backend::Auto picks CUDA when
     // a device is usable, otherwise the CPU with a one-line notice on stderr.
     Morpher(int width, int height, PixelFormat format, std::vector<KeyMap> keys,
@@ -119,7 +162,8 @@ public:
 
     // Each frame: `target` has lines() lines (a target line of zero length,
     // collapsed in this pose, is skipped for the frame), `weights` keys() entries, each
-    // >= 0, summing to at most 1 (a key with weight 0 costs nothing). Bad input
+    // finite and >= 0, summing to at most kMaxKeys (a key with weight 0 costs
+    // nothing; see MorphParams::rest for sums other than 1). Bad input
     // throws emoface::InputError before anything is written.
 
     // out: width * height pixels of format(), tightly packed, host memory.

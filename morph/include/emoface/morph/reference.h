@@ -16,7 +16,9 @@ void reference_positions(int width, int height, const std::vector<Layout>& key_l
                          const MorphParams& params, std::vector<double>& out);
 
 // out: width * height pixels of `format`, tightly packed. RGBA8 rounds to
-// nearest. params.accuracy is ignored (always exact).
+// nearest. params.accuracy is ignored (always exact). Follows morph.h's
+// formula: Σ w_k key_k + (1 − Σ w) rest, each key rest outside its region,
+// evaluated everywhere (no bounds).
 void reference_morph(int width, int height, PixelFormat format, const std::vector<KeyMap>& keys,
                      const Layout& target, const std::vector<float>& weights, const MorphParams& params, void* out);
 
