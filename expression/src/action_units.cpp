@@ -90,11 +90,11 @@ std::optional<AuTerm> parse_au_term(std::string_view text, std::string* error) {
     if (rest.empty() || ec != std::errc() || p != end || !std::isdigit(static_cast<unsigned char>(rest[0]))) {
         *error = fmt::format("\"{}\" is not an action unit; expected AU<number>, AU<number>L or AU<number>R "
                              "(e.g. AU12, AU12L)",
-                             text);
+                             echo_input(text, 40));
         return std::nullopt;
     }
     if (t.number < 1 || t.number >= kAuNumberLimit) {
-        *error = fmt::format("\"{}\": action units are numbered 1..{}", text, kAuNumberLimit - 1);
+        *error = fmt::format("\"{}\": action units are numbered 1..{}", echo_input(text, 40), kAuNumberLimit - 1);
         return std::nullopt;
     }
     return t;

@@ -80,7 +80,8 @@ bool operator==(const EmotionMix& a, const EmotionMix& b) { return a.weights == 
 bool operator!=(const EmotionMix& a, const EmotionMix& b) { return !(a == b); }
 
 EmotionMix parse_emotion_mix(std::string_view text, bool normalise) {
-    const std::string shown(text.substr(0, 200));
+    // The user's text, cut and with control characters escaped: one short line.
+    const std::string shown = echo_input(text, 60);
     auto bad = [&](const std::string& what) { fail<InputError>("expression: emotion mix \"{}\": {}", shown, what); };
     if (trim(text).empty()) bad("empty; expected e.g. \"anger=0.7,fear=0.3\" or \"0.7 anger + 0.3 fear\"");
 
@@ -105,7 +106,7 @@ EmotionMix parse_emotion_mix(std::string_view text, bool normalise) {
         const std::string_view part = trim(parts[k]);
         const int number = static_cast<int>(k) + 1;
         if (part.empty()) bad(fmt::format("part {} is empty", number));
-        const std::string where = fmt::format("part {} (\"{}\")", number, part);
+        const std::string where = fmt::format("part {} (\"{}\")", number, echo_input(part, 40));
         std::string_view name, weight;
         const auto eq = part.find('=');
         if (eq != std::string_view::npos) {
@@ -126,14 +127,15 @@ EmotionMix parse_emotion_mix(std::string_view text, bool normalise) {
         double w = 1.0;
         if (!weight.empty() && !parse_number(weight, &w)) {
             if (eq == std::string_view::npos && is_number_start(name)) bad(where + ": expected \"weight name\", the name comes last");
-            bad(fmt::format("{}: \"{}\" is not a number", where, weight));
+            bad(fmt::format("{}: \"{}\" is not a number", where, echo_input(weight, 40)));
         }
         std::string au_error;
         const auto au = parse_au_term(name, &au_error);
         if (!au_error.empty()) bad(fmt::format("{}: {}", where, au_error));
         const bool is_neutral = lower(name) == "neutral";
         const auto e = find_emotion(name);
-        if (!e && !is_neutral && !au) bad(fmt::format("unknown emotion \"{}\" in {}; {}", name, where, kExpected));
+        if (!e && !is_neutral && !au)
+            bad(fmt::format("unknown emotion \"{}\" in {}; {}", echo_input(name, 40), where, kExpected));
         if (w < 0) bad(fmt::format("{}: weight {:g} is negative; weights are in [0, 1]", where, w));
         if (w > 1) bad(fmt::format("{}: weight {:g} is above 1; weights are in [0, 1]", where, w));
         if (au) {

@@ -35,18 +35,19 @@ fap::FeaturePointPositions Face::positions() const {
     return out;
 }
 
-void update_fapu(Face& face) {
+void update_fapu(Face& face, const std::string& source) {
+    const std::string subject = source.empty() ? "face \"" + face.name + "\"" : source;
     std::string missing;
     for (const char* id : {"3.1", "3.3", "3.5", "3.6", "9.15", "2.2", "8.3", "8.4"}) {
         if (!face.has(fap::feature_point_index(id))) missing += missing.empty() ? id : std::string(", ") + id;
     }
     if (!missing.empty())
-        fail<InputError>("expression: face \"{}\": cannot compute FAPU without feature points {}", face.name, missing);
+        fail<InputError>("expression: {}: cannot compute FAPU without feature points {}", subject, missing);
     try {
         face.fapu = fap::compute_fapu(face.positions());
     } catch (const InputError& e) {
-        fail<InputError>("expression: face \"{}\": {} (x must point to the face's left, y up, z to the viewer)",
-                         face.name, e.what());
+        fail<InputError>("expression: {}: {} (x must point to the face's left, y up, z to the viewer)", subject,
+                         e.what());
     }
 }
 

@@ -1,19 +1,21 @@
 #include "emoface/expression/face_io.h"
 
-#include <cerrno>
+#include <cfloat>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
-#include <fstream>
+#include <iostream>
 #include <map>
 #include <optional>
 #include <sstream>
 
+#include <OpenMesh/Core/System/omstream.hh>
 #include <nlohmann/json.hpp>
 
 #include "emoface/common/atomic_file.h"
 #include "emoface/common/error.h"
+#include "emoface/common/input_file.h"
+#include "emoface/expression/rig.h"
 #include "emoface/fap/feature_points.h"
 #include "json_reader.h"
 
@@ -36,12 +38,71 @@ std::string stem_of(const std::string& path) {
     return dot == std::string::npos ? name : name.substr(0, dot);
 }
 
-std::string read_text(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) fail<InputError>("expression: cannot open {}: {}", path, std::strerror(errno));
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
+std::string read_text(const std::string& path) { return read_input_file(path, kMaxMeshFileBytes, "expression"); }
+
+// 1234567 -> "1,234,567" (counts in messages).
+std::string with_commas(long long n) {
+    std::string digits = std::to_string(n < 0 ? -n : n), out;
+    for (std::size_t i = 0; i < digits.size(); ++i) {
+        if (i > 0 && (digits.size() - i) % 3 == 0) out += ',';
+        out += digits[i];
+    }
+    return n < 0 ? "-" + out : out;
+}
+
+// Adds triangles to a mesh with OpenMesh's own per-triangle complaints
+// ("PolyMeshT::add_face: complex edge", one line each; 98,120 for one bad
+// file) captured instead of printed, and counted by kind for one message.
+class TriangleAdder {
+public:
+    explicit TriangleAdder(TriMesh& mesh) : mesh_(mesh) {
+        ::omerr().disconnect(std::cerr);
+        ::omerr().connect(captured_);
+    }
+    ~TriangleAdder() {
+        ::omerr().disconnect(captured_);
+        ::omerr().connect(std::cerr);
+    }
+    TriangleAdder(const TriangleAdder&) = delete;
+    TriangleAdder& operator=(const TriangleAdder&) = delete;
+
+    // Whether the triangle was added; a rejected one is counted and, the
+    // first time, `line` (the file's line it came from) kept.
+    bool add(int a, int b, int c, std::size_t line) {
+        if (mesh_.add_face(TriMesh::VertexHandle(a), TriMesh::VertexHandle(b), TriMesh::VertexHandle(c)).is_valid())
+            return true;
+        if (rejected_++ == 0) first_line_ = line;
+        return false;
+    }
+    long long rejected() const { return rejected_; }
+    std::size_t first_line() const { return first_line_; }
+    // "complex edges" / "complex vertices" / both, from what OpenMesh said.
+    std::string kinds() {
+        ::omerr().flush();
+        const std::string text = captured_.str();
+        std::string out;
+        for (auto [needle, name] : {std::pair{"complex edge", "complex edges"}, {"complex vertex", "complex vertices"}})
+            if (text.find(needle) != std::string::npos) out += (out.empty() ? "" : " and ") + std::string(name);
+        return out.empty() ? "edges or vertices shared in a way a manifold mesh cannot hold" : out;
+    }
+
+private:
+    TriMesh& mesh_;
+    std::ostringstream captured_;
+    long long rejected_ = 0;
+    std::size_t first_line_ = 0;
+};
+
+// A mesh the rig can drive is one surface: a triangle OpenMesh rejects
+// (an edge in three triangles, two triangles wound against each other, a
+// vertex joining two fans) would be a hole the rig's geodesic distances and
+// the wrinkle maps do not know about, so the file is refused, not patched.
+void check_all_added(TriangleAdder& adder, long long triangles, const std::string& file) {
+    if (adder.rejected() == 0) return;
+    fail_data("expression", FileLoc{file, static_cast<int>(adder.first_line()), ""},
+              "a manifold mesh (each edge in at most two triangles, wound alike)",
+              fmt::format("{} of {} triangles rejected: {}{}", with_commas(adder.rejected()), with_commas(triangles),
+                          adder.kinds(), adder.first_line() > 0 ? " (the first one here)" : ""));
 }
 
 std::vector<std::string_view> split_lines(std::string_view text) {
@@ -69,11 +130,12 @@ std::vector<std::string_view> tokens(std::string_view line) {
     return out;
 }
 
+// A coordinate: finite and within float's range, as the mesh stores floats.
 bool parse_double(std::string_view t, double* out) {
     // std::from_chars for double is in libstdc++ 11+.
     const char* end = t.data() + t.size();
     auto [p, ec] = std::from_chars(t.data(), end, *out);
-    return ec == std::errc() && p == end && std::isfinite(*out);
+    return ec == std::errc() && p == end && std::isfinite(*out) && std::abs(*out) <= FLT_MAX;
 }
 
 bool parse_int(std::string_view t, long long* out) {
@@ -82,15 +144,54 @@ bool parse_int(std::string_view t, long long* out) {
     return ec == std::errc() && p == end;
 }
 
-std::string quoted(std::string_view t) {
-    std::string s(t.substr(0, 40));
-    return "\"" + s + (t.size() > 40 ? "..." : "") + "\"";
-}
+std::string quoted(std::string_view t) { return "\"" + echo_input(t, 40) + "\""; }
+
+constexpr const char* kNumber = "a number (within a float's range, 3.4e38)";
 
 void finish_mesh(Face& face) {
     face.mesh.request_face_normals();
     face.mesh.request_vertex_normals();
     face.mesh.update_normals();
+}
+
+// The face's size and place in float arithmetic's comfortable range: the
+// rig, the layouts and the GL pipeline work in float, where a face 1e30 wide
+// gives lines of zero length and one 1e-30 wide underflows.
+constexpr double kMaxCoordinate = 1e7, kMinExtent = 1e-4;
+
+// A face the rig and the morph can drive, or an InputError naming `mesh_file`
+// (its size) or `source` (where its feature points come from):
+// coordinates in range, a face of some size not far from its origin, and
+// the rig built on it without complaint (feature points that coincide or
+// stand where no skin is give a singular or empty influence field).
+void check_face_geometry(const Face& face, const std::string& mesh_file, const std::string& source) {
+    double max_abs = 0.0;
+    glm::dvec3 lo(1e300), hi(-1e300);
+    for (auto vh : face.mesh.vertices()) {
+        const auto p = face.mesh.point(vh);
+        for (int c = 0; c < 3; ++c) {
+            max_abs = std::max(max_abs, std::abs(double(p[c])));
+            lo[c] = std::min(lo[c], double(p[c]));
+            hi[c] = std::max(hi[c], double(p[c]));
+        }
+    }
+    const double extent = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
+    if (max_abs > kMaxCoordinate || extent < kMinExtent || extent < max_abs * 1e-3)
+        fail_data("expression", FileLoc{mesh_file, 0, ""},
+                  fmt::format("a face between {:g} and {:g} units across (any unit), near its origin", kMinExtent,
+                              kMaxCoordinate),
+                  fmt::format("one {:.3g} across, {:.3g} from its origin", extent, max_abs));
+    try {
+        const FaceRig rig(face);
+    } catch (const InputError& e) {
+        std::string why = e.what();
+        for (const char* prefix : {"expression: rig: ", "expression: "})
+            if (why.rfind(prefix, 0) == 0) {
+                why = why.substr(std::string(prefix).size());
+                break;
+            }
+        fail<InputError>("expression: {}: the rig cannot drive this face: {}", source, why);
+    }
 }
 
 json vec_json(const Vec3d& v) { return json::array({v[0], v[1], v[2]}); }
@@ -253,6 +354,7 @@ Face load_obj_with_fdp(const std::string& obj_path, const std::string& fdp_path)
         int v, vt;
     };
     std::vector<std::vector<Corner>> polygons;
+    std::vector<std::size_t> polygon_lines;  // 1-based, for messages
     const auto lines = split_lines(text);
     for (std::size_t li = 0; li < lines.size(); ++li) {
         const auto t = tokens(lines[li]);
@@ -264,14 +366,14 @@ Face load_obj_with_fdp(const std::string& obj_path, const std::string& fdp_path)
             if (t.size() < 4) bad(fmt::format("expected \"v x y z\", found {} numbers", t.size() - 1));
             Vec3d p;
             for (int c = 0; c < 3; ++c)
-                if (!parse_double(t[1 + c], &p[c])) bad("expected a number, found " + quoted(t[1 + c]));
+                if (!parse_double(t[1 + c], &p[c])) bad(fmt::format("expected {}, found {}", kNumber, quoted(t[1 + c])));
             positions.push_back(p);
             if (static_cast<long long>(positions.size()) > kMaxElements) bad("more vertices than the 10 million allowed");
         } else if (t[0] == "vt") {
             if (t.size() < 3) bad("expected \"vt u v\"");
             std::array<double, 2> uv{};
             for (int c = 0; c < 2; ++c)
-                if (!parse_double(t[1 + c], &uv[c])) bad("expected a number, found " + quoted(t[1 + c]));
+                if (!parse_double(t[1 + c], &uv[c])) bad(fmt::format("expected {}, found {}", kNumber, quoted(t[1 + c])));
             uvs.push_back(uv);
         } else if (t[0] == "f") {
             if (t.size() < 4) bad(fmt::format("a face needs at least 3 corners, found {}", t.size() - 1));
@@ -296,6 +398,7 @@ Face load_obj_with_fdp(const std::string& obj_path, const std::string& fdp_path)
                 poly.push_back({static_cast<int>(vi - 1), static_cast<int>(ti - 1)});
             }
             polygons.push_back(std::move(poly));
+            polygon_lines.push_back(li + 1);
             if (static_cast<long long>(polygons.size()) > kMaxElements) bad("more faces than the 10 million allowed");
         }
         // o, g, s, usemtl, mtllib, vn, l, ...: not needed.
@@ -335,17 +438,20 @@ Face load_obj_with_fdp(const std::string& obj_path, const std::string& fdp_path)
         }
         return it->second;
     };
-    int rejected = 0;
-    for (const auto& poly : polygons)
-        for (std::size_t k = 1; k + 1 < poly.size(); ++k) {
-            const int a = vertex_for(poly[0]), b = vertex_for(poly[k]), c = vertex_for(poly[k + 1]);
-            if (a == b || b == c || a == c) continue;
-            if (!face.mesh.add_face(TriMesh::VertexHandle(a), TriMesh::VertexHandle(b), TriMesh::VertexHandle(c)).is_valid())
-                ++rejected;
+    {
+        TriangleAdder adder(face.mesh);
+        long long triangles = 0;
+        for (std::size_t p = 0; p < polygons.size(); ++p) {
+            const auto& poly = polygons[p];
+            for (std::size_t k = 1; k + 1 < poly.size(); ++k) {
+                const int a = vertex_for(poly[0]), b = vertex_for(poly[k]), c = vertex_for(poly[k + 1]);
+                if (a == b || b == c || a == c) continue;
+                ++triangles;
+                adder.add(a, b, c, polygon_lines[p]);
+            }
         }
-    if (rejected > 0)
-        fail<InputError>("expression: {}: {} triangles could not be added (the mesh is not manifold there)", obj_path,
-                         rejected);
+        check_all_added(adder, triangles, obj_path);
+    }
     face.parts.assign(face.mesh.n_vertices(), VertexPart::Skin);
     const int obj_vertices = static_cast<int>(positions.size());
 
@@ -437,12 +543,14 @@ Face load_obj_with_fdp(const std::string& obj_path, const std::string& fdp_path)
         if (root.has("base_colour")) face.base_colour_file = folder_of(fdp_path) + root.string("base_colour");
     });
     finish_mesh(face);
-    update_fapu(face);
+    update_fapu(face, fdp_path);
     estimate_pivots(face);
     if (jaw_pivot) face.jaw_pivot = *jaw_pivot;
     if (head_pivot) face.head_pivot = *head_pivot;
     face.texture_box = texture_box ? *texture_box : frontal_box(face);
+    face.source = fdp_path;
     validate_face(face, fdp_path);
+    check_face_geometry(face, obj_path, fdp_path);
     return face;
 }
 
@@ -493,14 +601,16 @@ Face parse_candide3(std::string_view text, const std::string& source, Candide3Re
         const auto t = next_data("all vertices were read");
         if (t.size() != 3) bad(li, fmt::format("vertex {}: expected 3 coordinates, found {}", i, t.size()));
         for (int c = 0; c < 3; ++c)
-            if (!parse_double(t[c], &vertices[i][c])) bad(li, fmt::format("vertex {}: expected a number, found {}", i, quoted(t[c])));
+            if (!parse_double(t[c], &vertices[i][c])) bad(li, fmt::format("vertex {}: expected {}, found {}", i, kNumber, quoted(t[c])));
         ++li;
     }
     find_section("FACE LIST");
     const int nf = read_count("faces");
     std::vector<std::array<int, 3>> faces(nf);
+    std::vector<std::size_t> face_lines(nf);  // 1-based, for messages
     for (int i = 0; i < nf; ++i) {
         const auto t = next_data("all faces were read");
+        face_lines[i] = li + 1;
         if (t.size() != 3) bad(li, fmt::format("face {}: expected 3 vertex indices, found {}", i, t.size()));
         for (int c = 0; c < 3; ++c) {
             long long v = 0;
@@ -516,13 +626,17 @@ Face parse_candide3(std::string_view text, const std::string& source, Candide3Re
     face.mesh.request_vertex_texcoords2D();
     for (const Vec3d& p : vertices)
         face.mesh.add_vertex(TriMesh::Point(static_cast<float>(p[0]), static_cast<float>(p[1]), static_cast<float>(p[2])));
-    int rejected = 0;
-    for (const auto& f : faces) {
-        if (f[0] == f[1] || f[1] == f[2] || f[0] == f[2]) continue;
-        if (!face.mesh.add_face(TriMesh::VertexHandle(f[0]), TriMesh::VertexHandle(f[1]), TriMesh::VertexHandle(f[2])).is_valid())
-            ++rejected;
+    {
+        TriangleAdder adder(face.mesh);
+        long long triangles = 0;
+        for (std::size_t i = 0; i < faces.size(); ++i) {
+            const auto& f = faces[i];
+            if (f[0] == f[1] || f[1] == f[2] || f[0] == f[2]) continue;
+            ++triangles;
+            adder.add(f[0], f[1], f[2], face_lines[i]);
+        }
+        check_all_added(adder, triangles, source);
     }
-    if (rejected > 0) fail<InputError>("expression: {}: {} faces could not be added (not manifold)", source, rejected);
     face.parts.assign(nv, VertexPart::Skin);
 
     // Feature points from the table; never invented where Candide-3 (or this
@@ -564,9 +678,11 @@ Face parse_candide3(std::string_view text, const std::string& source, Candide3Re
     r.triangles = static_cast<int>(face.mesh.n_faces());
     r.missing_feature_points = missing_feature_points(face);
     if (report) *report = r;
-    update_fapu(face);
+    face.source = source;
+    update_fapu(face, source);
     estimate_pivots(face);
     validate_face(face, source);
+    check_face_geometry(face, source, source);
     return face;
 }
 

@@ -242,4 +242,16 @@ std::vector<Segment> layout_segments(const std::vector<FeatureLine>& lines,
     return segments;
 }
 
+void check_lines_have_length(const std::vector<FeatureLine>& lines, const FeatureLayout& neutral,
+                             const std::string& source, float min_length) {
+    for (const FeatureLine& line : lines) {
+        const float length = glm::distance(neutral.points[line.from], neutral.points[line.to]);
+        if (length >= min_length && std::isfinite(length)) continue;
+        const std::string from(fap::feature_points()[line.from].id), to(fap::feature_points()[line.to].id);
+        fail_data("expression", FileLoc{source.empty() ? "the face" : source, 0, "feature_points"},
+                  fmt::format("{} and {} apart (a feature line of the wrinkle morph joins them)", from, to),
+                  "them at one place seen from the front");
+    }
+}
+
 }  // namespace emoface::expression

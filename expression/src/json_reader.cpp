@@ -1,10 +1,10 @@
 #include "json_reader.h"
 
 #include <algorithm>
-#include <filesystem>
-#include <fstream>
+#include <cfloat>
 #include <limits>
-#include <sstream>
+
+#include "emoface/common/input_file.h"
 
 namespace emoface::expression::detail {
 namespace {
@@ -13,17 +13,6 @@ constexpr const char* kModule = "expression";
 
 bool is_comment_key(const std::string& key) { return !key.empty() && key[0] == '_'; }
 
-// A key as it appears in a path: plain when it is a name or a number, quoted
-// when it holds dots or other marks ("feature_points."2.1".vertex").
-std::string path_key(const std::string& key) {
-    const bool plain = !key.empty() &&
-                       std::all_of(key.begin(), key.end(), [](char c) {
-                           return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
-                                  c == '_' || c == '-';
-                       });
-    return plain ? key : "\"" + key + "\"";
-}
-
 // The text after "line L, column C: " in nlohmann's parse message.
 std::string syntax_detail(const std::string& what) {
     const auto column = what.find("column ");
@@ -31,35 +20,123 @@ std::string syntax_detail(const std::string& what) {
     return colon == std::string::npos ? what : what.substr(colon + 2);
 }
 
+// Keys and values are the file's text: shown cut and with control
+// characters escaped, so a message stays one short line.
+constexpr std::size_t kMaxShownKey = 40;
+constexpr int kMaxDepth = 256;  // nesting of arrays and objects; data files use < 10
+
+// A key as it appears in a path: plain when it is a name or a number, quoted
+// when it holds dots or other marks ("feature_points."2.1".vertex").
+std::string path_key(const std::string& key) {
+    const bool plain = !key.empty() && key.size() <= kMaxShownKey &&
+                       std::all_of(key.begin(), key.end(), [](char c) {
+                           return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                                  c == '_' || c == '-';
+                       });
+    return plain ? key : "\"" + echo_input(key, kMaxShownKey) + "\"";
+}
+
+// nlohmann's DOM builder, told where in the document it is, so that an error
+// the parser finds (a syntax error, a number beyond double range) names the
+// key path as well as the line, and nesting is bounded.
+class LocatingParser : public nlohmann::detail::json_sax_dom_parser<nlohmann::json> {
+    using Base = nlohmann::detail::json_sax_dom_parser<nlohmann::json>;
+
+public:
+    LocatingParser(nlohmann::json& root, std::string_view text, const std::string& file)
+        : Base(root, true), text_(text), file_(file) {}
+
+    bool null() { return value(), Base::null(); }
+    bool boolean(bool v) { return value(), Base::boolean(v); }
+    bool number_integer(number_integer_t v) { return value(), Base::number_integer(v); }
+    bool number_unsigned(number_unsigned_t v) { return value(), Base::number_unsigned(v); }
+    bool number_float(number_float_t v, const string_t& s) { return value(), Base::number_float(v, s); }
+    bool string(string_t& v) { return value(), Base::string(v); }
+    bool binary(binary_t& v) { return value(), Base::binary(v); }
+    bool start_object(std::size_t n) { return open(false), Base::start_object(n); }
+    bool end_object() { return frames_.pop_back(), Base::end_object(); }
+    bool start_array(std::size_t n) { return open(true), Base::start_array(n); }
+    bool end_array() { return frames_.pop_back(), Base::end_array(); }
+    bool key(string_t& k) {
+        frames_.back().key = k;
+        return Base::key(k);
+    }
+
+    template <class Exception>
+    bool parse_error(std::size_t byte, const std::string& token, const Exception& e) {
+        const FileLoc at{file_, line_at(byte), path()};
+        if (e.id == 406)  // number overflow
+            fail_data(kModule, at, "a number", echo_input(token, 40) + ", beyond the range of a double");
+        fail_data(kModule, at, "valid JSON", echo_input(syntax_detail(e.what()), 160));
+    }
+
+private:
+    struct Frame {
+        bool array = false;
+        std::size_t count = 0;  // elements started, in an array
+        std::string key;        // the last key read, in an object
+    };
+
+    int line_at(std::size_t byte) const {
+        const std::size_t end = std::min(byte, text_.size());
+        return 1 + static_cast<int>(std::count(text_.begin(), text_.begin() + static_cast<long>(end), '\n'));
+    }
+    // The value being read: the innermost array's next element, or the
+    // element an outer array is inside.
+    std::string path() const {
+        std::string out;
+        for (std::size_t i = 0; i < frames_.size(); ++i) {
+            const Frame& f = frames_[i];
+            const bool innermost = i + 1 == frames_.size();
+            if (f.array) out += fmt::format("[{}]", innermost ? f.count : f.count - 1);
+            else if (!f.key.empty() || !innermost) out = json_key_path(out, f.key);
+        }
+        return out;
+    }
+    void value() {
+        if (!frames_.empty() && frames_.back().array) ++frames_.back().count;
+    }
+    void open(bool array) {
+        value();
+        if (static_cast<int>(frames_.size()) >= kMaxDepth)
+            fail_data(kModule, FileLoc{file_, 0, path()}, fmt::format("at most {} levels of nesting", kMaxDepth),
+                      "more");
+        frames_.push_back({array, 0, {}});
+    }
+
+    std::string_view text_;
+    const std::string& file_;
+    std::vector<Frame> frames_;
+};
+
+
 }  // namespace
 
 std::string describe_json(const nlohmann::json& value) {
     constexpr std::size_t kMax = 40;
-    std::string text = value.dump();
-    if (text.size() > kMax) text = text.substr(0, kMax) + "...";
+    // Containers dumped whole only to be cut would cost their size; strings
+    // are escaped by dump() itself.
+    std::string text;
+    if (value.is_string()) text = nlohmann::json(value.get_ref<const std::string&>().substr(0, 4 * kMax)).dump();
+    else if (value.is_array() && value.size() > kMax) text = "an array of " + std::to_string(value.size()) + " values";
+    else if (value.is_object() && value.size() > kMax) text = "an object of " + std::to_string(value.size()) + " keys";
+    else text = value.dump();
+    if (text.size() > kMax) text = echo_input(text, kMax);
     return text;
 }
 
-std::string read_text_file(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in)
-        fail_data(kModule, FileLoc{path, 0, ""}, "a readable file",
-                  std::filesystem::exists(path) ? "one that cannot be opened" : "no such file");
-    std::ostringstream text;
-    text << in.rdbuf();
-    return text.str();
-}
+std::string read_text_file(const std::string& path) { return read_input_file(path, kMaxJsonFileBytes, kModule); }
 
 nlohmann::json parse_json(std::string_view text, const std::string& file) {
+    nlohmann::json doc;
+    LocatingParser parser(doc, text, file);
     try {
-        return nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/true);
-    } catch (const nlohmann::json::parse_error& e) {
-        const std::size_t end = std::min<std::size_t>(e.byte, text.size());
-        const int line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(end), '\n'));
-        fail_data(kModule, FileLoc{file, line, ""}, "valid JSON", syntax_detail(e.what()));
+        nlohmann::json::sax_parse(text, &parser, nlohmann::json::input_format_t::json, /*strict=*/true,
+                                  /*ignore_comments=*/true);
     } catch (const nlohmann::json::exception& e) {
-        fail_data(kModule, FileLoc{file, 0, ""}, "valid JSON", e.what());
+        fail_data(kModule, FileLoc{file, 0, ""}, "valid JSON", echo_input(e.what(), 160));
     }
+    return doc;
 }
 
 std::string json_key_path(const std::string& parent, const std::string& key) {
@@ -108,7 +185,11 @@ std::vector<JsonReader> JsonReader::objects(const std::string& key) {
 
 double JsonReader::as_number() const {
     if (!value_->is_number() || !std::isfinite(value_->get<double>())) fail("a number");
-    return value_->get<double>();
+    // Stored as float in many places (mesh points, textures, GL uniforms):
+    // what float cannot hold would become inf there.
+    const double v = value_->get<double>();
+    if (std::abs(v) > FLT_MAX) fail("a number within the range of a float (3.4e38)");
+    return v;
 }
 
 double JsonReader::as_number_in(double min, double max) const {
@@ -116,6 +197,7 @@ double JsonReader::as_number_in(double min, double max) const {
     if (!value_->is_number()) fail(expected);
     const double v = value_->get<double>();
     if (!(v >= min && v <= max)) fail(expected);
+    if (std::abs(v) > FLT_MAX) fail("a number within the range of a float (3.4e38)");
     return v;
 }
 
@@ -186,7 +268,7 @@ void JsonReader::finish() const {
         for (const std::string& k : comments_) keys += (keys.empty() ? "" : ", ") + k;
         fail_data(kModule, FileLoc{file_, 0, child_path(key)},
                   keys.empty() ? std::string("no keys here") : "a known key (" + keys + ")",
-                  "\"" + key + "\"");
+                  "\"" + echo_input(key, kMaxShownKey) + "\"");
     }
 }
 

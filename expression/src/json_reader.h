@@ -150,7 +150,7 @@ std::array<double, N> JsonReader::as_numbers() const {
     for (std::size_t i = 0; i < N; ++i) {
         const nlohmann::json& v = (*value_)[i];
         if (!v.is_number() || !std::isfinite(v.get<double>())) fail(expected);
-        out[i] = v.get<double>();
+        out[i] = JsonReader(v, file_, path_ + "[" + std::to_string(i) + "]").as_number();
     }
     return out;
 }

@@ -45,6 +45,8 @@ std::unique_ptr<FaceAssets> load_face_assets(expression::Face face, const std::s
     for (int i = 0; i < expression::kFeatureCount; ++i) present[i] = a->face.feature_points[i].present;
     a->lines = expression::lines_for_face(expression::load_feature_lines(dir + "feature_lines.json"),
                                           present);
+    // A line of zero length at neutral would stop the morph; say so naming the face's file.
+    expression::check_lines_have_length(a->lines, posed_layout(a->face, *a->rig, {}, a->layout), a->face.source);
     const expression::WrinkleLibrarySpec spec = expression::load_wrinkle_spec(dir + "wrinkles.json");
     a->times.profiles_ms = ms_since(t);
 

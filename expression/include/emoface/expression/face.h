@@ -108,6 +108,9 @@ struct Face {
     // For a face loaded from files: the base-colour image its FDP names
     // (absolute path, "" if none); the renderer loads it.
     std::string base_colour_file;
+    // The file the face was read from (the FDP of an OBJ face, the .wfm),
+    // for messages about its geometry; "" for the generated default face.
+    std::string source;
     // Pairs of vertices that are one point of the surface, split only so
     // each can carry its own texture coordinate (UV seams). The rig moves
     // them alike; the default face's eye and mouth slits are NOT welded.
@@ -126,7 +129,8 @@ struct Face {
 // Throws emoface::InputError naming the missing feature points when one of
 // those FAPU need (3.1, 3.3, 3.5, 3.6, 9.15, 2.2, 8.3, 8.4) is absent, and when
 // the face is mirrored (ES0 or MW0 not positive: x must be the face's left).
-void update_fapu(Face& face);
+// Messages name `source` (the file the face came from) or else the face.
+void update_fapu(Face& face, const std::string& source = {});
 
 // Checks the invariants the rig relies on (sizes agree, feature point vertices
 // in range, eyeball ranges inside the mesh); throws emoface::InputError with

@@ -114,4 +114,10 @@ std::vector<Segment> layout_segments(const std::vector<FeatureLine>& lines,
                                      const FeatureLayout& layout,
                                      float min_length = 1e-4f);
 
+// The face's neutral layout must give every line a length (the morph's key 0
+// defines the lines): throws InputError naming `source` (the face's file) and
+// the two feature points of the first line shorter than `min_length`.
+void check_lines_have_length(const std::vector<FeatureLine>& lines, const FeatureLayout& neutral,
+                             const std::string& source, float min_length = 1e-4f);
+
 }  // namespace emoface::expression
