@@ -3,6 +3,7 @@
 #include <cuda_runtime.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -108,6 +109,95 @@ INSTANTIATE_TEST_SUITE_P(
         ParityCase{"exact_K2_N0", 64, 48, 2, 0, PixelFormat::Rgba8, false, 2.0f, Accuracy::Exact, -1},
         ParityCase{"fast_K2_N0", 64, 48, 2, 0, PixelFormat::Rgba8, false, 2.0f, Accuracy::Fast, -1}),
     [](const auto& info) { return std::string(info.param.name); });
+
+// Rest value, many keys and region keys (morph.h): the CUDA backend against
+// the CPU, which tests/morph/morph_test.cpp holds to the formula.
+struct RestCase {
+    const char* name;
+    int keys;         // all of them region keys but key 0 when `regions`
+    int weighted;     // keys 0 .. weighted-1 at weight `weight` each
+    float weight;
+    bool regions;
+    PixelFormat format;
+    Accuracy accuracy;
+};
+
+class MorphCudaRest : public ::testing::TestWithParam<RestCase> {};
+
+TEST_P(MorphCudaRest, CudaAgreesWithTheCpu) {
+    SKIP_WITHOUT_CUDA();
+    const RestCase& c = GetParam();
+    const int w = 160, h = 128;
+    const Layout base = random_layout(24, 41);
+    RandomKeys random = random_keys(w, h, c.keys, c.format, true, base, 42);
+    if (c.regions)
+        for (int k = 1; k < c.keys; ++k) {  // ~6% of the map each, spread over it
+            const float x0 = 0.05f + 0.7f * static_cast<float>((k * 37) % 19) / 19.0f;
+            const float y0 = 0.05f + 0.7f * static_cast<float>((k * 23) % 17) / 17.0f;
+            random.keys[k].region = {x0, y0, x0 + 0.25f, y0 + 0.25f};
+        }
+    std::vector<float> weights(c.keys, 0.0f);
+    for (int k = 0; k < c.weighted; ++k) weights[k] = c.weight;
+    weights[0] = 1.0f;
+    MorphParams params;
+    params.normal_map = true;
+    params.rest = {0.5f, 0.5f, 1.0f, 1.0f};
+    params.accuracy = c.accuracy;
+    const Layout target = jitter(base, 0.04f, 43);
+    const std::size_t n = static_cast<std::size_t>(w) * h * 4;
+    std::vector<std::uint8_t> bytes[2];
+    std::vector<float> floats[2];
+    const Backend backends[2] = {Backend::Cpu, Backend::Cuda};
+    for (int i = 0; i < 2; ++i) {
+        Morpher m(w, h, c.format, random.keys, backends[i]);
+        if (c.format == PixelFormat::Rgba8) {
+            bytes[i].assign(n, 0xCD);
+            m.morph_to_host(target, weights, params, bytes[i].data());
+        } else {
+            floats[i].assign(n, -7.0f);
+            m.morph_to_host(target, weights, params, floats[i].data());
+        }
+    }
+    const double lsb = c.accuracy == Accuracy::Exact ? 1.0 : 2.0;
+    if (c.format == PixelFormat::Rgba8)
+        EXPECT_LE(max_abs_diff(bytes[0], bytes[1]), lsb) << "LSB";
+    else
+        EXPECT_LE(max_abs_diff(floats[0], floats[1]), lsb / 255.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, MorphCudaRest,
+    ::testing::Values(
+        RestCase{"half_weight_one_key", 1, 1, 0.5f, false, PixelFormat::RgbaF32, Accuracy::Exact},
+        RestCase{"k32_22_weighted_exact", 32, 22, 0.3f, false, PixelFormat::Rgba8, Accuracy::Exact},
+        RestCase{"k32_22_weighted_fast", 32, 22, 0.3f, false, PixelFormat::RgbaF32, Accuracy::Fast},
+        RestCase{"regions_21_keys_4_weighted_exact", 21, 5, 1.0f, true, PixelFormat::Rgba8, Accuracy::Exact},
+        RestCase{"regions_21_keys_4_weighted_fast", 21, 5, 1.0f, true, PixelFormat::Rgba8, Accuracy::Fast},
+        RestCase{"regions_32_keys_all_weighted_fast", 32, 32, 0.8f, true, PixelFormat::RgbaF32, Accuracy::Fast}),
+    [](const auto& info) { return std::string(info.param.name); });
+
+// A key at weight 0 is not read on the GPU either: NaN pixels change nothing.
+TEST(MorphCuda, AKeyAtWeightZeroIsNeverRead) {
+    SKIP_WITHOUT_CUDA();
+    const int w = 64, h = 48;
+    const Layout base = random_layout(6, 51), target = jitter(base, 0.04f, 52);
+    const auto a = to_float(random_rgba8(w, h, 53));
+    const std::vector<float> garbage(a.size(), std::nanf(""));
+    KeyMap ka, kg;
+    ka.pixels = a.data();
+    ka.layout = base;
+    kg.pixels = garbage.data();
+    kg.layout = jitter(base, 0.05f, 54);
+    for (Accuracy acc : {Accuracy::Exact, Accuracy::Fast}) {
+        MorphParams params;
+        params.accuracy = acc;
+        std::vector<float> alone(a.size()), with_nan(a.size());
+        Morpher(w, h, PixelFormat::RgbaF32, {ka}, Backend::Cuda).morph_to_host(target, {1.0f}, params, alone.data());
+        Morpher(w, h, PixelFormat::RgbaF32, {kg, ka, kg}, Backend::Cuda)
+            .morph_to_host(target, {0.0f, 1.0f, 0.0f}, params, with_nan.data());
+        EXPECT_EQ(alone, with_nan) << to_string(acc);
+    }
+}
 
 KeyMap key(const void* pixels, Layout layout) {
     KeyMap k;

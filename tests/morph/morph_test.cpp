@@ -2,6 +2,8 @@
 // agreement with the double-precision reference, the fast mode, bad input.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -569,6 +571,283 @@ INSTANTIATE_TEST_SUITE_P(
                       CpuPathCase{"crowded_float_K2", 48, 48, 2, 40, PixelFormat::RgbaF32, 0.01f, 2.0f, 0.5f, false, 4}),
     [](const auto& info) { return std::string(info.param.name); });
 
+// ---- rest value, many keys, regions ----------------------------------------------------
+//
+// out = Σ w_k key_k + (1 − Σ w) rest, a key being rest outside its region
+// (morph.h). Keys of constant colour make the warp irrelevant where a test
+// is about the blend.
+
+std::vector<float> constant_map(int w, int h, std::array<float, 4> c) {
+    std::vector<float> img(static_cast<std::size_t>(w) * h * 4);
+    for (std::size_t i = 0; i < img.size(); ++i) img[i] = c[i % 4];
+    return img;
+}
+
+// Morphs `keys` (RgbaF32 or Rgba8 pixels as given) and returns the output as
+// floats in the format's units.
+std::vector<float> morph_floats(int w, int h, PixelFormat format, const std::vector<KeyMap>& keys,
+                                const Layout& target, const std::vector<float>& weights, const MorphParams& params) {
+    Morpher m(w, h, format, keys, Backend::Cpu);
+    std::vector<float> out(static_cast<std::size_t>(w) * h * 4);
+    if (format == PixelFormat::RgbaF32) {
+        m.morph_to_host(target, weights, params, out.data());
+    } else {
+        std::vector<std::uint8_t> bytes(out.size());
+        m.morph_to_host(target, weights, params, bytes.data());
+        for (std::size_t i = 0; i < out.size(); ++i) out[i] = bytes[i];
+    }
+    return out;
+}
+
+// Weights summing to 1: rest has no share, so the thesis's convex blend is
+// the same to the last bit whatever rest is (and rest = 0 is the old path).
+TEST(MorphRest, WeightsSummingToOneGiveTheConvexBlendBitForBit) {
+    const int w = 40, h = 32;
+    const Layout base = random_layout(6, 301), target = jitter(base, 0.04f, 302);
+    for (PixelFormat format : {PixelFormat::Rgba8, PixelFormat::RgbaF32})
+        for (bool normal_map : {false, true})
+            for (Accuracy acc : {Accuracy::Exact, Accuracy::Fast}) {
+                SCOPED_TRACE(std::string(to_string(format)) + (normal_map ? " normals " : " colour ") + to_string(acc));
+                RandomKeys keys = random_keys(w, h, 3, format, normal_map, base, 303);
+                MorphParams plain;
+                plain.normal_map = normal_map;
+                plain.accuracy = acc;
+                MorphParams with_rest = plain;
+                with_rest.rest = {0.5f, 0.5f, 1.0f, 1.0f};
+                const std::vector<float> weights{0.2f, 0.3f, 0.5f};
+                EXPECT_EQ(morph_floats(w, h, format, keys.keys, target, weights, plain),
+                          morph_floats(w, h, format, keys.keys, target, weights, with_rest));
+            }
+}
+
+TEST(MorphRest, OneKeyAtHalfWeightIsHalfwayToRest) {
+    const int w = 24, h = 20;
+    const auto img = to_float(random_rgba8(w, h, 311));
+    const Layout l = random_layout(5, 312);
+    MorphParams params;
+    params.rest = {0.25f, 0.5f, 0.75f, 1.0f};
+    for (Accuracy acc : {Accuracy::Exact, Accuracy::Fast}) {
+        params.accuracy = acc;
+        const std::vector<float> out = morph_floats(w, h, PixelFormat::RgbaF32, {key(img.data(), l)}, l, {0.5f}, params);
+        std::vector<float> expected(img.size());
+        for (std::size_t i = 0; i < img.size(); ++i) expected[i] = 0.5f * img[i] + 0.5f * params.rest[i % 4];
+        EXPECT_LT(max_abs_diff(out, expected), 1e-6) << to_string(acc);
+    }
+    // Moved lines: the double reference follows the same formula (RGBA8, regions too).
+    const auto bytes = random_rgba8(w, h, 313);
+    KeyMap k = key(bytes.data(), l);
+    k.region = {0.2f, 0.3f, 0.7f, 0.8f};
+    const Layout target = jitter(l, 0.04f, 314);
+    std::vector<std::uint8_t> ref(bytes.size());
+    reference_morph(w, h, PixelFormat::Rgba8, {k}, target, {0.5f}, params, ref.data());
+    params.accuracy = Accuracy::Exact;
+    const std::vector<float> out = morph_floats(w, h, PixelFormat::Rgba8, {k}, target, {0.5f}, params);
+    EXPECT_LE(max_abs_diff(out, std::vector<float>(ref.begin(), ref.end())), 1.0);
+}
+
+// Wrinkle keys over flat skin: the slopes (x, y of the decoded normal) of
+// overlapping keys add, as height-field gradients do; z and the cavity
+// alpha add their deviations from flat; the sum is clamped to the encoding's
+// range before it is renormalised.
+TEST(MorphRest, NormalMapKeysOverFlatSkinAddSlopesAndCavities) {
+    const int w = 16, h = 12;
+    const Layout l = random_layout(4, 321);
+    const std::array<float, 4> flat{0.5f, 0.5f, 1.0f, 1.0f};
+    auto encode = [](double x, double y, double a) {
+        const double len = std::sqrt(x * x + y * y + 1.0);
+        return std::array<float, 4>{static_cast<float>(0.5 + 0.5 * x / len), static_cast<float>(0.5 + 0.5 * y / len),
+                                    static_cast<float>(0.5 + 0.5 / len), static_cast<float>(a)};
+    };
+    const std::array<float, 4> kx = encode(0.3, 0.0, 0.8), ky = encode(0.0, -0.2, 0.7);
+    const auto mx = constant_map(w, h, kx), my = constant_map(w, h, ky);
+    // What the blend must hold: flat + Σ w (key − flat), clamped to [0, 1],
+    // then renormalised (alpha as is).
+    auto expected = [&](double wx, double wy) {
+        double c[4];
+        for (int i = 0; i < 4; ++i)
+            c[i] = std::clamp(flat[i] + wx * (kx[i] - flat[i]) + wy * (ky[i] - flat[i]), 0.0, 1.0);
+        double n[3], len2 = 0.0;
+        for (int i = 0; i < 3; ++i) {
+            n[i] = 2.0 * c[i] - 1.0;
+            len2 += n[i] * n[i];
+        }
+        std::array<double, 4> out;
+        for (int i = 0; i < 3; ++i) out[i] = 0.5 + 0.5 * n[i] / std::sqrt(len2);
+        out[3] = c[3];
+        return out;
+    };
+    MorphParams params;
+    params.normal_map = true;
+    params.rest = flat;
+    struct Case {
+        const char* name;
+        float wx, wy;
+    };
+    for (const Case& c : {Case{"one key", 1.0f, 0.0f}, Case{"two keys", 1.0f, 1.0f}, Case{"doubled", 2.0f, 0.0f},
+                          Case{"partial", 0.6f, 0.9f}, Case{"clamped", 6.0f, 5.0f}}) {
+        SCOPED_TRACE(c.name);
+        const std::vector<float> out =
+            morph_floats(w, h, PixelFormat::RgbaF32, {key(mx.data(), l), key(my.data(), l)}, jitter(l, 0.05f, 322),
+                         {c.wx, c.wy}, params);
+        const std::array<double, 4> e = expected(c.wx, c.wy);
+        for (int ch = 0; ch < 4; ++ch) EXPECT_NEAR(out[ch], e[ch], 1e-5) << "channel " << ch;
+        EXPECT_EQ(max_abs_diff(out, constant_map(w, h, {out[0], out[1], out[2], out[3]})), 0.0) << "not uniform";
+    }
+    // Two equal slopes: the decoded x/z ratio doubles (gradients add).
+    const std::vector<float> two =
+        morph_floats(w, h, PixelFormat::RgbaF32, {key(mx.data(), l), key(mx.data(), l)}, l, {1.0f, 1.0f}, params);
+    const double one_ratio = (2.0 * kx[0] - 1.0) / (2.0 * kx[2] - 1.0);
+    const double two_ratio = (2.0 * two[0] - 1.0) / (2.0 * two[2] - 1.0);
+    EXPECT_GT(two_ratio, 1.9 * one_ratio);
+    // The cavity channel: 1 + (0.8 − 1) + (0.7 − 1) = 0.5; clamped at 0 for 6 and 5.
+    EXPECT_NEAR(expected(1.0, 1.0)[3], 0.5, 1e-6);
+    EXPECT_EQ(expected(6.0, 5.0)[3], 0.0);
+}
+
+// A key at weight 0 costs nothing: it is neither warped nor sampled, so even
+// NaN pixels leave the output exactly as without it.
+TEST(MorphKeys, AKeyAtWeightZeroIsNeverRead) {
+    const int w = 32, h = 24;
+    const Layout base = random_layout(5, 331), target = jitter(base, 0.04f, 332);
+    const auto a = to_float(random_rgba8(w, h, 333));
+    const std::vector<float> garbage(a.size(), std::nanf(""));
+    const Layout lg = jitter(base, 0.05f, 334);
+    for (Accuracy acc : {Accuracy::Exact, Accuracy::Fast}) {
+        MorphParams params;
+        params.accuracy = acc;
+        params.rest = {0.5f, 0.5f, 1.0f, 1.0f};
+        for (float wa : {1.0f, 0.7f}) {
+            const auto alone = morph_floats(w, h, PixelFormat::RgbaF32, {key(a.data(), base)}, target, {wa}, params);
+            const auto with_nan = morph_floats(w, h, PixelFormat::RgbaF32,
+                                               {key(garbage.data(), lg), key(a.data(), base), key(garbage.data(), lg)},
+                                               target, {0.0f, wa, 0.0f}, params);
+            EXPECT_EQ(alone, with_nan) << to_string(acc) << " weight " << wa;
+        }
+    }
+}
+
+// kMaxKeys keys, most of them at weight > 0 (three batches of sources), agree
+// with the double reference.
+TEST(MorphKeys, KMaxKeysBlendLikeTheReference) {
+    const int w = 24, h = 20;
+    const Layout base = random_layout(5, 341), target = jitter(base, 0.04f, 342);
+    RandomKeys keys = random_keys(w, h, Morpher::kMaxKeys, PixelFormat::Rgba8, false, base, 343);
+    std::vector<float> weights(Morpher::kMaxKeys, 0.0f);
+    for (int k = 0; k < Morpher::kMaxKeys; ++k)
+        if (k % 3 != 2) weights[k] = 0.045f;  // 22 keys, Σ = 0.99
+    MorphParams params;
+    params.rest = {0.2f, 0.4f, 0.6f, 0.8f};
+    std::vector<std::uint8_t> ref(static_cast<std::size_t>(w) * h * 4);
+    reference_morph(w, h, PixelFormat::Rgba8, keys.keys, target, weights, params, ref.data());
+    const std::vector<float> ref_f(ref.begin(), ref.end());
+    for (Accuracy acc : {Accuracy::Exact, Accuracy::Fast}) {
+        params.accuracy = acc;
+        params.fast_reach = 64.0f;  // every line near: fast is exact here
+        EXPECT_LE(max_abs_diff(morph_floats(w, h, PixelFormat::Rgba8, keys.keys, target, weights, params), ref_f), 1.0)
+            << to_string(acc);
+    }
+}
+
+// Many region keys (batches of sources that differ from block to block) over
+// a neutral key, weights summing to 7.6, normal maps over flat skin: the
+// reference, which evaluates every key everywhere, agrees.
+TEST(MorphKeys, ManyRegionKeysBlendLikeTheReference) {
+    const int w = 56, h = 48;
+    const Layout base = random_layout(6, 361), target = jitter(base, 0.04f, 362);
+    RandomKeys keys = random_keys(w, h, 13, PixelFormat::Rgba8, true, base, 363);
+    std::vector<float> weights(13, 0.0f);
+    weights[0] = 1.0f;
+    for (int k = 1; k < 13; ++k) {
+        const float x0 = 0.05f + 0.06f * static_cast<float>(k), y0 = 0.7f - 0.05f * static_cast<float>(k);
+        keys.keys[k].region = {x0, y0, x0 + 0.2f, y0 + 0.22f};
+        if (k != 4 && k != 9) weights[k] = 0.66f;
+    }
+    MorphParams params;
+    params.normal_map = true;
+    params.rest = {128.0f / 255.0f, 128.0f / 255.0f, 1.0f, 1.0f};
+    std::vector<std::uint8_t> ref(static_cast<std::size_t>(w) * h * 4);
+    reference_morph(w, h, PixelFormat::Rgba8, keys.keys, target, weights, params, ref.data());
+    const std::vector<float> ref_f(ref.begin(), ref.end());
+    for (Accuracy acc : {Accuracy::Exact, Accuracy::Fast}) {
+        params.accuracy = acc;
+        params.fast_reach = 64.0f;  // every line near: fast is exact here
+        params.fast_cell = 4;
+        EXPECT_LE(max_abs_diff(morph_floats(w, h, PixelFormat::Rgba8, keys.keys, target, weights, params), ref_f), 1.0)
+            << to_string(acc);
+    }
+}
+
+// A key with a region is the same key over the whole map with rest outside
+// the region, whatever its own pixels hold there, for targets that keep,
+// jitter, move and scale the region, exact and fast.
+struct RegionCase {
+    const char* name;
+    float dx, dy, scale, jitter;
+};
+
+class MorphRegion : public ::testing::TestWithParam<RegionCase> {};
+
+TEST_P(MorphRegion, ARegionKeyIsTheWholeKeyWithRestOutsideItsRegion) {
+    const RegionCase& c = GetParam();
+    const int w = 80, h = 64;
+    const Layout base = random_layout(7, 351);
+    Layout target = jitter(base, c.jitter, 352);
+    for (Line& l : target) {
+        l = {0.5f + c.scale * (l.px - 0.5f) + c.dx, 0.5f + c.scale * (l.py - 0.5f) + c.dy,
+             0.5f + c.scale * (l.qx - 0.5f) + c.dx, 0.5f + c.scale * (l.qy - 0.5f) + c.dy};
+    }
+    const Region region{0.3f, 0.25f, 0.55f, 0.5f};
+    // Rest 128/255 (RGBA8 holds it exactly) over flat-ish keys.
+    const std::array<float, 4> rest{128.0f / 255.0f, 128.0f / 255.0f, 1.0f, 1.0f};
+    for (PixelFormat format : {PixelFormat::Rgba8, PixelFormat::RgbaF32}) {
+        const auto neutral8 = random_rgba8(w, h, 353), wrinkle8 = random_rgba8(w, h, 354);
+        auto whole8 = wrinkle8, garbage8 = wrinkle8;
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const bool inside = x >= region.x0 * w && x < region.x1 * w && y >= region.y0 * h && y < region.y1 * h;
+                for (int ch = 0; ch < 4; ++ch) {
+                    const std::size_t i = (static_cast<std::size_t>(y) * w + x) * 4 + ch;
+                    if (!inside) {
+                        whole8[i] = static_cast<std::uint8_t>(std::lround(rest[ch] * 255.0f));
+                        garbage8[i] = static_cast<std::uint8_t>(255 - (i % 7) * 30);
+                    }
+                }
+            }
+        const auto neutralf = to_float(neutral8), wholef = to_float(whole8), garbagef = to_float(garbage8);
+        const bool f32 = format == PixelFormat::RgbaF32;
+        KeyMap neutral = key(f32 ? static_cast<const void*>(neutralf.data()) : neutral8.data(), jitter(base, 0.03f, 355));
+        KeyMap whole = key(f32 ? static_cast<const void*>(wholef.data()) : whole8.data(), base);
+        KeyMap cropped = key(f32 ? static_cast<const void*>(garbagef.data()) : garbage8.data(), base);
+        cropped.region = region;
+        for (Accuracy acc : {Accuracy::Exact, Accuracy::Fast}) {
+            for (bool normal_map : {false, true}) {
+                SCOPED_TRACE(std::string(to_string(format)) + " " + to_string(acc) + (normal_map ? " normals" : ""));
+                MorphParams params;
+                params.accuracy = acc;
+                params.rest = rest;
+                params.normal_map = normal_map;
+                const std::vector<float> weights{1.0f, 0.8f};
+                const auto a = morph_floats(w, h, format, {neutral, whole}, target, weights, params);
+                const auto b = morph_floats(w, h, format, {neutral, cropped}, target, weights, params);
+                // Where the region key is left out, rest's share is added
+                // to the last bit differently: rounding only.
+                EXPECT_LE(max_abs_diff(a, b), f32 ? 1e-5 : 1.0);
+                // ... and the wrinkle key does show (it is not simply dropped).
+                const auto plain = morph_floats(w, h, format, {neutral, cropped}, target, {1.0f, 0.0f}, params);
+                EXPECT_GT(max_abs_diff(b, plain), f32 ? 0.05 : 12.0);
+            }
+        }
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Targets, MorphRegion,
+                         ::testing::Values(RegionCase{"same_layout", 0.0f, 0.0f, 1.0f, 0.0f},
+                                           RegionCase{"jittered", 0.0f, 0.0f, 1.0f, 0.03f},
+                                           RegionCase{"moved", 0.2f, -0.15f, 1.0f, 0.01f},
+                                           RegionCase{"scaled_and_moved", -0.1f, 0.1f, 1.3f, 0.02f},
+                                           RegionCase{"shrunk", 0.05f, 0.0f, 0.7f, 0.02f}),
+                         [](const auto& info) { return std::string(info.param.name); });
+
 // ---- bad input -------------------------------------------------------------------------
 
 struct BadInput {
@@ -607,6 +886,12 @@ std::vector<BadInput> bad_inputs() {
     KeyMap small = key(px, three);
     small.width = 8;
     small.height = 16;
+    KeyMap flipped = key(px, three);
+    flipped.region = {0.5f, 0.0f, 0.4f, 1.0f};
+    KeyMap outside = key(px, three);
+    outside.region = {0.0f, 0.0f, 1.5f, 1.0f};
+    MorphParams nan_rest;
+    nan_rest.rest[2] = std::nanf("");
 
     return {
         {"size zero", [=] { Morpher(0, 16, PixelFormat::Rgba8, {key(px, three)}, Backend::Cpu); },
@@ -614,9 +899,17 @@ std::vector<BadInput> bad_inputs() {
         {"size too large", [=] { Morpher(16, 20000, PixelFormat::Rgba8, {key(px, three)}, Backend::Cpu); },
          "morph: Morpher(): size 16 x 20000, expected width and height in 1..16384"},
         {"K = 0", [] { Morpher(16, 16, PixelFormat::Rgba8, {}, Backend::Cpu); },
-         "morph: Morpher(): K = 0 key maps, expected 1 to 8"},
-        {"K = 9", [=] { Morpher(16, 16, PixelFormat::Rgba8, std::vector<KeyMap>(9, key(px, three)), Backend::Cpu); },
-         "morph: Morpher(): K = 9 key maps, expected 1 to 8"},
+         "morph: Morpher(): K = 0 key maps, expected 1 to 32"},
+        {"K = kMaxKeys + 1",
+         [=] {
+             Morpher(16, 16, PixelFormat::Rgba8, std::vector<KeyMap>(Morpher::kMaxKeys + 1, key(px, three)),
+                     Backend::Cpu);
+         },
+         "morph: Morpher(): K = 33 key maps, expected 1 to 32 (Morpher::kMaxKeys)"},
+        {"region inside out", [=] { Morpher(16, 16, PixelFormat::Rgba8, {key(px, three), flipped}, Backend::Cpu); },
+         "morph: Morpher(): key 1 region is (0.5, 0) - (0.4, 1), expected 0 <= x0 < x1 <= 1 and 0 <= y0 < y1 <= 1"},
+        {"region past the map", [=] { Morpher(16, 16, PixelFormat::Rgba8, {outside}, Backend::Cpu); },
+         "morph: Morpher(): key 0 region is (0, 0) - (1.5, 1), expected 0 <= x0 < x1 <= 1"},
         {"null pixels", [=] { Morpher(16, 16, PixelFormat::Rgba8, {key(px, three), key(nullptr, three)}, Backend::Cpu); },
          "morph: Morpher(): key 1 has no pixels (null pointer)"},
         {"sizes differ", [=] { Morpher(16, 16, PixelFormat::Rgba8, {key(px, three), small}, Backend::Cpu); },
@@ -641,7 +934,10 @@ std::vector<BadInput> bad_inputs() {
          "morph: morph_to_host(): weight 1 is -0.25, expected a finite value >= 0"},
         {"NaN weight", frame(three, {std::nanf(""), 0.5f}),
          "morph: morph_to_host(): weight 0 is nan, expected a finite value >= 0"},
-        {"weights over 1", frame(three, {0.75f, 0.75f}), "morph: morph_to_host(): weights sum to 1.5, expected at most 1"},
+        {"weights over kMaxKeys", frame(three, {20.0f, 13.0f}),
+         "morph: morph_to_host(): weights sum to 33, expected at most 32 (kMaxKeys)"},
+        {"NaN rest", frame(three, {0.5f, 0.5f}, nan_rest),
+         "morph: morph_to_host(): params.rest[2] = nan, expected a finite value"},
         {"a = 0", frame(three, {0.5f, 0.5f}, a0), "morph: morph_to_host(): params.a = 0, expected a finite value > 0"},
         {"b < 0", frame(three, {0.5f, 0.5f}, bneg), "morph: morph_to_host(): params.b = -1, expected a value in [0, 16]"},
         {"fast cell", frame(three, {0.5f, 0.5f}, cell5),
@@ -721,7 +1017,7 @@ TEST(MorphBadInput, ABadFrameLeavesTheMorpherUsable) {
     const Layout l = random_layout(3, 152);
     Morpher m(16, 16, PixelFormat::Rgba8, {key(img.data(), l)}, Backend::Cpu);
     std::vector<std::uint8_t> out(img.size());
-    EXPECT_THROW(m.morph_to_host(l, {2.0f}, {}, out.data()), InputError);
+    EXPECT_THROW(m.morph_to_host(l, {40.0f}, {}, out.data()), InputError);
     m.morph_to_host(l, {1.0f}, {}, out.data());
     EXPECT_EQ(max_abs_diff(out, img), 0.0);
 }
