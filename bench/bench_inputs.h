@@ -92,19 +92,24 @@ inline std::vector<float> make_weights(int k, unsigned seed) {
     return w;
 }
 
-// One input set: K key maps with their layouts, and a few targets with weights.
+// One input set: K key maps with their layouts, and a few targets with
+// weights. Key k shows images[image_of[k]] (images[k] where image_of is
+// empty) within regions[k] (the whole map where regions is empty).
 struct InputSet {
     std::vector<std::vector<std::uint8_t>> images;
+    std::vector<int> image_of;
+    std::vector<morph::Region> regions;
     std::vector<morph::Layout> layouts;
     std::vector<morph::Layout> targets;
     std::vector<std::vector<float>> weights;
 
     std::vector<morph::KeyMap> keys() const {
         std::vector<morph::KeyMap> k;
-        for (std::size_t i = 0; i < images.size(); ++i) {
+        for (std::size_t i = 0; i < layouts.size(); ++i) {
             morph::KeyMap m;
-            m.pixels = images[i].data();
+            m.pixels = images[image_of.empty() ? i : image_of[i]].data();
             m.layout = layouts[i];
+            if (!regions.empty()) m.region = regions[i];
             k.push_back(m);
         }
         return k;
@@ -121,6 +126,42 @@ inline InputSet make_input_set(int size, int lines, int keys, unsigned seed, int
     for (int t = 0; t < targets; ++t) {
         s.weights.push_back(make_weights(keys, seed * 131 + t));
         s.targets.push_back(mix_layouts(s.layouts, s.weights.back()));
+    }
+    return s;
+}
+
+// Per-Action-Unit wrinkle keys: a full neutral key and `au_keys` keys whose
+// wrinkles cover a small region each (0.26² of the map, about 7%, spread
+// over the face), each at its own layout; per target the neutral key and 4
+// of the AU keys at weight 1 (a frame's active AUs), over flat skin. With
+// `regions` false the same keys declare the whole map (what regions save).
+// Two images serve all keys: the cost under test is the warp and the
+// samples, not the upload.
+inline InputSet make_au_input_set(int size, int lines, int au_keys, bool regions, unsigned seed, int targets = 4) {
+    InputSet s;
+    const morph::Layout base = make_base_layout(lines, 1000 + lines);
+    s.images.push_back(make_image(size, size, seed * 31));
+    s.images.push_back(make_image(size, size, seed * 31 + 1));
+    for (int k = 0; k <= au_keys; ++k) {
+        s.image_of.push_back(k == 0 ? 0 : 1);
+        s.layouts.push_back(make_key_layout(base, 77 + k));
+        const float x0 = 0.12f + 0.5f * static_cast<float>((k * 7) % 11) / 10.0f;
+        const float y0 = 0.12f + 0.5f * static_cast<float>((k * 5) % 9) / 8.0f;
+        s.regions.push_back(k == 0 || !regions ? morph::Region{} : morph::Region{x0, y0, x0 + 0.26f, y0 + 0.26f});
+    }
+    for (int t = 0; t < targets; ++t) {
+        std::vector<float> w(au_keys + 1, 0.0f), mix(au_keys + 1, 0.0f);
+        w[0] = 1.0f;
+        for (int a = 0; a < 4; ++a) w[1 + (t * 5 + a * 3) % au_keys] = 1.0f;
+        // The target layout: neutral moved a fifth of the way to each active key.
+        mix[0] = 1.0f;
+        for (int k = 1; k <= au_keys; ++k)
+            if (w[k] > 0.0f) {
+                mix[k] = 0.2f;
+                mix[0] -= 0.2f;
+            }
+        s.weights.push_back(w);
+        s.targets.push_back(mix_layouts(s.layouts, mix));
     }
     return s;
 }

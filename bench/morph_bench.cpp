@@ -68,6 +68,7 @@ struct Options {
     int error_max_size = 4096;   // fast-mode position error measured up to this size
     int cpu_error_max_size = 1024;
     std::string out;  // also write the report here
+    int au_keys = 0;  // > 0: also the per-AU wrinkle case, 1 neutral + au_keys small-region keys
 };
 
 struct Row {
@@ -120,8 +121,13 @@ public:
 
     void run() {
         for (int size : o_.sizes)
-            for (int lines : o_.lines)
+            for (int lines : o_.lines) {
                 for (int keys : o_.keys) run_config(size, lines, keys);
+                if (o_.au_keys > 0) {
+                    run_au_config(size, lines, true);
+                    run_au_config(size, lines, false);
+                }
+            }
     }
 
     std::string report(const std::string& command) const {
@@ -217,6 +223,39 @@ private:
         }
     }
 
+    // The per-AU wrinkle case (bench_inputs.h, make_au_input_set): normal
+    // maps over flat skin, weights summing to 5; rows named "... au
+    // regions" (small-region keys) and "... au whole" (the same keys
+    // declaring the whole map).
+    void run_au_config(int size, int lines, bool regions) {
+        const int keys = o_.au_keys + 1;
+        std::fprintf(stderr, "config %d² N=%d K=%d per-AU keys, %s\n", size, lines, keys,
+                     regions ? "small regions" : "whole maps");
+        std::vector<bench::InputSet> inputs;
+        for (int s = 0; s < 2; ++s) inputs.push_back(bench::make_au_input_set(size, lines, o_.au_keys, regions, 7 + s));
+        const std::string suffix = regions ? " au regions" : " au whole";
+        base_params_.normal_map = true;
+        base_params_.rest = {0.5f, 0.5f, 1.0f, 1.0f};
+#if defined(EMOFACE_BENCH_CUDA)
+        const std::string config = std::to_string(size) + "², N = " + std::to_string(lines) + ", K = " +
+                                   std::to_string(keys) + suffix;
+        if (morph::cuda_available() && wants("cuda"))
+            run_cuda(size, lines, keys, inputs, Accuracy::Exact, 8, 0.0f, "cuda exact" + suffix, config);
+        if (morph::cuda_available() && wants("fast"))
+            for (int cell : o_.fast_cells)
+                for (float reach : o_.fast_reach)
+                    run_cuda(size, lines, keys, inputs, Accuracy::Fast, cell, reach,
+                             fast_name("cuda", cell, reach) + suffix, config);
+#endif
+        if (wants("cpu")) {
+            run_cpu(size, lines, keys, inputs, Accuracy::Exact, 8, 0.0f, "cpu exact" + suffix);
+            for (int cell : o_.fast_cells)
+                for (float reach : o_.fast_reach)
+                    run_cpu(size, lines, keys, inputs, Accuracy::Fast, cell, reach, fast_name("cpu", cell, reach) + suffix);
+        }
+        base_params_ = MorphParams{};
+    }
+
     static std::string fast_name(const char* backend, int cell, float reach) {
         char buf[64];
         std::snprintf(buf, sizeof buf, "%s fast c%d r%g", backend, cell, reach);
@@ -228,7 +267,7 @@ private:
         std::vector<std::unique_ptr<Morpher>> m;
         for (int s = 0; s < 2; ++s)
             m.push_back(std::make_unique<Morpher>(size, size, morph::PixelFormat::Rgba8, inputs[s].keys(), Backend::Cpu));
-        MorphParams params;
+        MorphParams params = base_params_;
         params.accuracy = acc;
         params.fast_cell = cell;
         params.fast_reach = reach;
@@ -280,7 +319,7 @@ private:
                 st.upload_ms = m[0]->setup_times().upload_ms;
             }
         }
-        MorphParams params;
+        MorphParams params = base_params_;
         params.accuracy = acc;
         params.fast_cell = cell;
         params.fast_reach = reach;
@@ -422,6 +461,7 @@ private:
 #endif
 
     Options o_;
+    MorphParams base_params_;  // what each row's frames start from (the per-AU case: normal maps over flat skin)
     std::vector<Row> rows_;
     std::map<std::pair<std::string, std::string>, Stages> stages_;
 };
@@ -444,6 +484,9 @@ int main(int argc, char** argv) {
     app.add_option("--error-max-size", o.error_max_size, "largest size whose CUDA fast error is measured");
     app.add_option("--cpu-error-max-size", o.cpu_error_max_size, "largest size whose CPU fast error is measured");
     app.add_option("--out", o.out, "also write the Markdown report to this file");
+    app.add_option("--au-keys", o.au_keys,
+                   "also the per-AU wrinkle case: 1 neutral + this many small-region keys (e.g. 20), 4 active")
+        ->check(CLI::Range(1, Morpher::kMaxKeys - 1));
     CLI11_PARSE(app, argc, argv);
 
     std::string command = "bench/morph";

@@ -14,7 +14,8 @@
 //          sums of all lines, tile_kernel listing each cell's near lines
 //          (and its corner sums without them),
 //          then apply_kernel over the pixels: far sums interpolated, near
-//          lines exact (kernel.h, "fast mode"), texture-unit sampling.
+//          lines exact (kernel.h, "fast mode"), texture-unit sampling
+//          (keys cropped to a region by hand: rest outside the crop).
 // Nothing is allocated per frame; buffers for positions, host output and the
 // fast grid are allocated at their first use.
 #include <cuda_runtime.h>
