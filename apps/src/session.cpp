@@ -86,8 +86,6 @@ std::string format_times(const LoadTimes& load, const FrameTimeTotals& frames) {
 }
 
 fap::FapStream load_fap_stream(const std::string& path) {
-    if (!std::filesystem::is_regular_file(path))
-        fail<InputError>("fap: {}: no such file", path);
     fap::FapStream stream = fap::read_fap_file(path);
     if (stream.frames.empty()) fail<InputError>("fap: {}: the file has no frames", path);
     if (!(stream.fps > 0)) fail<InputError>("fap: {}: frame rate {} is not positive", path, stream.fps);
@@ -174,7 +172,9 @@ expression::Face load_session_face(const SessionOptions& o) {
         fo.texture_size = o.texture_size;
         return expression::make_default_face(o.data + "/face", fo);
     }
-    if (!std::filesystem::is_regular_file(o.face))
+    // Missing: the hint; there but a FIFO, a device, a link loop: the readers say which.
+    std::error_code ec;
+    if (!std::filesystem::exists(o.face, ec) && !ec)
         fail<InputError>("session: --face {}: no such file (expected default, FILE.wfm or FILE.obj)", o.face);
     if (ends_with(o.face, ".wfm")) {
         if (!o.fdp.empty()) fail<InputError>("session: --fdp is for an .obj face, not a Candide-3 .wfm");
@@ -184,11 +184,11 @@ expression::Face load_session_face(const SessionOptions& o) {
         std::string fdp = o.fdp;
         if (fdp.empty()) {
             fdp = o.face.substr(0, o.face.size() - 4) + ".fdp.json";
-            if (!std::filesystem::is_regular_file(fdp))
+            if (!std::filesystem::exists(fdp, ec) && !ec)
                 fail<InputError>("session: --face {}: give its feature points with --fdp FILE.json "
                                  "(looked for {})",
                                  o.face, fdp);
-        } else if (!std::filesystem::is_regular_file(fdp)) {
+        } else if (!std::filesystem::exists(fdp, ec) && !ec) {
             fail<InputError>("session: --fdp {}: no such file", fdp);
         }
         expression::Face face = expression::load_obj_with_fdp(o.face, fdp);

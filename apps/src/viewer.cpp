@@ -640,9 +640,10 @@ int run_viewer(const ViewerOptions& options) {
     if (!options.fap_path.empty()) stream = fap::resolve_untransmitted(load_fap_stream(options.fap_path));
     const expression::EmotionMix mix =
         options.mix.empty() ? expression::EmotionMix{} : expression::parse_emotion_mix(options.mix);
-    if (so.face != "default" && !std::filesystem::is_regular_file(so.face))
+    std::error_code ec;  // a FIFO, a device, a link loop: the face readers say which
+    if (so.face != "default" && !std::filesystem::exists(so.face, ec) && !ec)
         fail<InputError>("{}: --face {}: no such file (expected default, FILE.wfm or FILE.obj)", command, so.face);
-    if (!so.fdp.empty() && !std::filesystem::is_regular_file(so.fdp))
+    if (!so.fdp.empty() && !std::filesystem::exists(so.fdp, ec) && !ec)
         fail<InputError>("{}: --fdp {}: no such file", command, so.fdp);
     if (!so.wrinkle_folder.empty() && !std::filesystem::is_directory(so.wrinkle_folder))
         fail<InputError>("{}: --wrinkles {}: no such folder (expected one `emoface wrinkles --out` wrote)", command,

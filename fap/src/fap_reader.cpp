@@ -12,6 +12,7 @@
 #include <string>
 
 #include "emoface/common/error.h"
+#include "emoface/common/input_file.h"
 #include "emoface/fap/fap_io.h"
 #include "text.h"
 
@@ -355,25 +356,7 @@ FapStream parse_fap(std::string_view text, const std::string& source_name) {
 }
 
 FapStream read_fap_file(const std::string& path) {
-    std::error_code ec;
-    if (std::filesystem::is_directory(path, ec))
-        fail<InputError>("fap: {}: expected a FAP file, found a directory", path);
-    std::ifstream in(path, std::ios::binary);
-    if (!in)
-        fail<InputError>("fap: {}: expected a readable FAP file, found {}", path,
-                         std::strerror(errno));
-    // Read in chunks so a pipe or a huge file never asks for its whole
-    // claimed size at once.
-    std::string text;
-    char chunk[1 << 16];
-    while (in.read(chunk, sizeof chunk) || in.gcount() > 0) {
-        text.append(chunk, static_cast<std::size_t>(in.gcount()));
-        if (static_cast<long long>(text.size()) > kMaxFapFileBytes)
-            fail<InputError>("fap: {}: expected a FAP file of at most {} bytes, found a larger one",
-                             path, kMaxFapFileBytes);
-    }
-    if (in.bad()) fail<InputError>("fap: {}: expected a readable FAP file, found a read error", path);
-    return parse_fap(text, path);
+    return parse_fap(read_input_file(path, static_cast<std::uint64_t>(kMaxFapFileBytes), "fap"), path);
 }
 
 }  // namespace emoface::fap

@@ -70,7 +70,7 @@ TEST_F(InfoCli, BadFileIsOneLineAndExitTwo) {
     const CommandResult missing = run_emoface({"info", scratch_.path("none.fap")});
     EXPECT_EQ(missing.exit_code, 2);
     EXPECT_EQ(missing.err, "emoface: fap: " + scratch_.path("none.fap") +
-                               ": expected a readable FAP file, found No such file or directory\n");
+                               ": expected a regular file of at most 256 MiB, found no such file\n");
 }
 
 TEST_F(InfoCli, SeveralFilesReportEveryGoodOneAndStillFail) {

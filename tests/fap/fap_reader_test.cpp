@@ -324,13 +324,14 @@ TEST(FapReader, MissingFile) {
         read_fap_file("/nonexistent/x.fap");
         ADD_FAILURE();
     } catch (const InputError& e) {
-        EXPECT_STREQ(e.what(), "fap: /nonexistent/x.fap: expected a readable FAP file, found No such file or directory");
+        EXPECT_STREQ(e.what(), "fap: /nonexistent/x.fap: expected a regular file of at most 256 MiB, found no such file");
     }
     try {
         read_fap_file(EMOFACE_TEST_SOURCE_DIR);
         ADD_FAILURE();
     } catch (const InputError& e) {
-        EXPECT_EQ(std::string(e.what()), "fap: " EMOFACE_TEST_SOURCE_DIR ": expected a FAP file, found a directory");
+        EXPECT_EQ(std::string(e.what()),
+                  "fap: " EMOFACE_TEST_SOURCE_DIR ": expected a regular file of at most 256 MiB, found a directory");
     }
 }
 

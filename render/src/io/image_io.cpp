@@ -2,12 +2,20 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
 #include <filesystem>
+#include <optional>
 #include <vector>
 
 #include "emoface/common/atomic_file.h"
 #include "emoface/common/error.h"
+#include "emoface/common/input_file.h"
 #include "emoface/common/output_batch.h"
 
 namespace emoface::render {
@@ -60,13 +68,68 @@ void write_pixels(const std::string& path, int width, int height, OIIO::TypeDesc
     commit_temporary(temp, path, "render");
 }
 
+// OpenImageIO's messages may span lines (libpng's, then its own): the first
+// one, cut, is the reason.
+std::string first_line(const std::string& text) { return echo_input(text.substr(0, text.find('\n')), 120); }
+
+// A PNG whose chunks run past the end of the file (a truncated download, a
+// copy cut short). Checked before libpng sees it: libpng prints its own
+// "libpng error: ..." lines to stderr for it, beside our one line.
+std::string png_truncation(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    char signature[8];
+    if (!in.read(signature, 8) || std::memcmp(signature, "\x89PNG\r\n\x1a\n", 8) != 0) return "";
+    in.seekg(0, std::ios::end);
+    const std::uint64_t size = static_cast<std::uint64_t>(in.tellg());
+    std::uint64_t at = 8;
+    while (at + 8 <= size) {
+        unsigned char head[8];
+        in.seekg(static_cast<std::streamoff>(at));
+        if (!in.read(reinterpret_cast<char*>(head), 8)) break;
+        const std::uint64_t length = (std::uint64_t(head[0]) << 24) | (head[1] << 16) | (head[2] << 8) | head[3];
+        at += 12 + length;  // length, type, data, CRC
+        if (std::memcmp(head + 4, "IEND", 4) == 0) return at <= size ? "" : "a PNG cut short in its IEND chunk";
+    }
+    return fmt::format("a PNG cut short after {} bytes (no IEND chunk)", size);
+}
+
+// libpng reports a corrupt file by printing "libpng error: ..." to stderr
+// itself, then OpenImageIO hands the same reason to geterror(): stderr is
+// pointed at /dev/null while an image is decoded, so only our line remains.
+class QuietStderr {
+public:
+    QuietStderr() {
+        std::fflush(stderr);
+        saved_ = ::dup(2);
+        const int null = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
+        if (saved_ >= 0 && null >= 0) ::dup2(null, 2);
+        if (null >= 0) ::close(null);
+    }
+    ~QuietStderr() {
+        std::fflush(stderr);
+        if (saved_ >= 0) {
+            ::dup2(saved_, 2);
+            ::close(saved_);
+        }
+    }
+    QuietStderr(const QuietStderr&) = delete;
+    QuietStderr& operator=(const QuietStderr&) = delete;
+
+private:
+    int saved_ = -1;
+};
+
 template <typename T>
 std::vector<T> read_rgba(const std::string& path, OIIO::TypeDesc type, int& width, int& height) {
+    check_input_file(path, kMaxImageFileBytes, "render");
+    if (const std::string cut = png_truncation(path); !cut.empty())
+        fail_data("render", FileLoc{path, 0, ""}, "a whole image file", cut);
     // Keep straight alpha as stored (OpenImageIO would premultiply it).
     OIIO::ImageSpec config;
     config.attribute("oiio:UnassociatedAlpha", 1);
+    std::optional<QuietStderr> quiet(std::in_place);
     auto in = OIIO::ImageInput::open(path, &config);
-    if (!in) fail<InputError>("render: {}: cannot read the image: {}", path, OIIO::geterror());
+    if (!in) fail<InputError>("render: {}: cannot read the image: {}", path, first_line(OIIO::geterror()));
     const OIIO::ImageSpec& spec = in->spec();
     width = spec.width;
     height = spec.height;
@@ -75,8 +138,10 @@ std::vector<T> read_rgba(const std::string& path, OIIO::TypeDesc type, int& widt
         fail<InputError>("render: {}: unsupported image size {}x{} with {} channels", path,
                          width, height, channels);
     std::vector<T> raw(std::size_t(width) * height * channels);
-    if (!in->read_image(0, 0, 0, channels, type, raw.data()))
-        fail<InputError>("render: {}: cannot read the pixels: {}", path, in->geterror());
+    const bool read = in->read_image(0, 0, 0, channels, type, raw.data());
+    quiet.reset();
+    if (!read)
+        fail<InputError>("render: {}: cannot read the pixels: {}", path, first_line(in->geterror()));
     in->close();
     const T one = type == OIIO::TypeDesc::UINT8 ? T(255) : T(1);
     std::vector<T> rgba(std::size_t(width) * height * 4);
