@@ -177,7 +177,7 @@ int main(int argc, char** argv) {
         // The check frame: saved (reference) or compared.
         if (!save.empty() || !compare.empty()) {
             const expression::FaceState st = state_of(frame_at(check_frame));
-            scene.update(st.faps, render::key_weights(st.mix));
+            scene.update(st.faps, render::key_weights(assets->keys, st));
             platform.begin_frame();
             scene.draw(draw);
             platform.end_frame();
@@ -207,7 +207,7 @@ int main(int argc, char** argv) {
         for (long i = 0; i < warmup + frames; ++i) {
             const auto t0 = Clock::now();
             const expression::FaceState st = state_of(frame_at(i));
-            scene.update(st.faps, render::key_weights(st.mix));
+            scene.update(st.faps, render::key_weights(assets->keys, st));
             platform.begin_frame();
             scene.draw(draw);
             platform.end_frame();
@@ -233,7 +233,7 @@ int main(int argc, char** argv) {
             auto t0 = Clock::now();
             const expression::FaceState state = state_of(frame_at(i));
             const expression::FapValues& faps = state.faps;
-            const std::vector<float> w = render::key_weights(state.mix);
+            const std::vector<float> w = render::key_weights(assets->keys, state);
             const double sample_ms = ms(Clock::now() - t0);
             scene.update_geometry(faps);
             const render::FrameStageTimes st = scene.last_times();

@@ -2,6 +2,9 @@
 // expression to another at t = 0, 0.25, 0.5, 0.75, 1) and its stage timings
 // (table 6.1: allocate, upload, kernel, bump mapping, free).
 // Rows of the sheet:
+// The two keys are the thesis's emotion keys, made from the AU wrinkle
+// library like every key (render::make_emotion_key: the union of the
+// emotion's AUs' wrinkles at its layout), blended convexly as the thesis does.
 //   1. the wrinkle map morphed with Beier-Neely onto the face's layout at t
 //   2. the same two maps cross-dissolved, with no warp (the features of the
 //      two keys sit in different places, so their wrinkles ghost)
@@ -12,6 +15,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,6 +27,7 @@
 #include "emoface/common/timing.h"
 #include "emoface/expression/emotion.h"
 #include "emoface/morph/morph.h"
+#include "emoface/render/face_assets.h"
 #include "session.h"
 #include "sheet.h"
 
@@ -39,7 +44,7 @@ struct MorphArgs {
     MorphArgs() { session.options.wrinkle_size = 256; }  // the thesis's maps
 };
 
-// The key (expression::WrinkleKey order: neutral, joy .. surprise) named.
+// The key named: 0 neutral, 1 + emotion_index for an emotion.
 int key_index(const std::string& name, const char* option) {
     if (name == "neutral") return 0;
     const auto e = expression::find_emotion(name);
@@ -47,6 +52,11 @@ int key_index(const std::string& name, const char* option) {
         fail<InputError>("morph: {} '{}': expected neutral, joy, sadness, anger, fear, disgust or surprise",
                          option, name);
     return expression::emotion_index(*e) + 1;
+}
+
+std::optional<expression::Emotion> key_emotion(int key) {
+    if (key == 0) return std::nullopt;
+    return expression::kEmotions[std::size_t(key - 1)];
 }
 
 expression::EmotionMix transition_mix(int from, int to, double t) {
@@ -73,9 +83,9 @@ render::ImageRGBA8 cross_dissolve(const expression::NormalMap& a, const expressi
     return out;
 }
 
-morph::Layout key_layout(const Session& s, int key) {
+morph::Layout key_layout(const Session& s, const render::WrinkleKey& key) {
     morph::Layout out;
-    for (const auto& seg : expression::layout_segments(s.lines(), s.assets().keys[std::size_t(key)].layout))
+    for (const auto& seg : expression::layout_segments(s.lines(), key.layout))
         out.push_back({seg.p.x, seg.p.y, seg.q.x, seg.q.y});
     return out;
 }
@@ -90,16 +100,20 @@ void run_morph(const MorphArgs& a) {
     if (a.out.empty()) fail<InputError>("morph: --out sheet.png is required");
     check_output_folder(a.out, "morph");
     Session session(so);
-    const auto& keys = session.assets().keys;
-    const int size = keys[std::size_t(from)].map.width;
+    const int size = session.scene().wrinkle_texture().width();
+    const render::WrinkleKey key_from = render::make_emotion_key(session.assets(), key_emotion(from), size);
+    const render::WrinkleKey key_to = render::make_emotion_key(session.assets(), key_emotion(to), size);
 
     // The thesis's pipeline on two textures: [1] allocate, [2] upload, [3]
     // the kernel each frame, [4] free; a Morpher of its own so the stages are
     // those of the two-key morph alone.
     const morph::MorphParams params = session.scene().morph_params();
-    std::vector<morph::KeyMap> maps = {
-        {keys[std::size_t(from)].map.rgba.data(), key_layout(session, from), size, size},
-        {keys[std::size_t(to)].map.rgba.data(), key_layout(session, to), size, size}};
+    std::vector<morph::KeyMap> maps(2);
+    for (const auto& [map, key] : {std::pair{&maps[0], &key_from}, std::pair{&maps[1], &key_to}}) {
+        map->pixels = key->map.rgba.data();
+        map->layout = key_layout(session, *key);
+        map->width = map->height = size;
+    }
     auto morpher = std::make_unique<morph::Morpher>(size, size, morph::PixelFormat::Rgba8, std::move(maps), so.backend);
     const morph::SetupTimes setup = morpher->setup_times();
 
@@ -127,9 +141,12 @@ void run_morph(const MorphArgs& a) {
         bn.captions.push_back(caption);
 
         auto& platform = session.platform();
-        // Figure 6.4 is drawn with the thesis's Blinn-Phong.
+        // Figure 6.4 is drawn with the thesis's Blinn-Phong, bump-mapped with
+        // row 1's map (the session's own keys are the AU keys).
         auto draw = session.draw_options(1.0f);
         draw.shading = render::Shading::Thesis;
+        platform.make_current();
+        session.scene().wrinkle_texture().upload(morphed.pixels.data());
         auto b0 = Clock::now();
         platform.begin_frame();
         session.draw(draw);
@@ -138,7 +155,7 @@ void run_morph(const MorphArgs& a) {
         bump_ms.push_back(ms_since(b0));
         bn_face.captions.push_back(caption);
 
-        const render::ImageRGBA8 blend = cross_dissolve(keys[std::size_t(from)].map, keys[std::size_t(to)].map, float(t));
+        const render::ImageRGBA8 blend = cross_dissolve(key_from.map, key_to.map, float(t));
         dissolve.tiles.push_back(shade(blend));
         dissolve.captions.push_back(caption);
         platform.make_current();

@@ -1,12 +1,14 @@
-// emoface wrinkles: writes the seven key wrinkle maps (neutral + six
-// emotions) and the feature layout each was made at, so an artist can replace
-// any map with a painted one plus its layout.
+// emoface wrinkles: writes the key wrinkle maps (neutral + one per wrinkling
+// AU and side, named as key_weights reads them: AU6L, AU17, ...) and the
+// feature layout each was made at, so an artist can replace any map with a
+// painted one plus its layout (or write emotion keys: joy.png, ...).
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 
 #include "command.h"
 #include "emoface/common/error.h"
+#include "emoface/common/output_batch.h"
 #include "emoface/expression/feature_layout.h"
 #include "emoface/render/face_assets.h"
 #include "emoface/render/wrinkle_keys_io.h"
@@ -33,6 +35,9 @@ void run_wrinkles(const WrinklesArgs& args) {
     const fs::path parent = fs::absolute(args.out).parent_path();
     if (!fs::is_directory(parent, ec))
         fail<InputError>("wrinkles: --out {}: folder {} does not exist", args.out, parent.string());
+    // The maps and layouts appear together or not at all; the folder is made
+    // (and proved writable) now, before the slow part.
+    OutputBatch batch(args.out, "wrinkles: --out " + args.out);
 
     const auto layout = render::parse_wrinkle_layout(args.layout);
     if (!layout) fail<InputError>("wrinkles: --layout '{}': expected projective or anchored", args.layout);
@@ -47,8 +52,13 @@ void run_wrinkles(const WrinklesArgs& args) {
     asset_options.layout = *layout;
     const auto assets = render::load_face_assets(load_session_face(face_options), args.data, asset_options);
 
-    fs::create_directories(args.out);
-    render::write_wrinkle_keys(args.out, assets->keys);
+    std::string staging;
+    for (const render::WrinkleKey& key : assets->keys) {
+        staging = fs::path(batch.stage(key.name + ".png")).parent_path().string();
+        batch.stage(key.name + ".layout.json");
+    }
+    render::write_wrinkle_keys(staging, assets->keys);
+    batch.commit();
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::printf("wrinkles: %zu maps of %dx%d and their layouts in %s (%.1f s)\n", assets->keys.size(),
@@ -61,8 +71,9 @@ void add_wrinkles_command(CLI::App& root) {
     auto args = std::make_shared<WrinklesArgs>();
     CLI::App* sub = root.add_subcommand(
         "wrinkles",
-        "Write the seven key wrinkle maps (neutral + six emotions, tangent-space normal maps, PNG)\n"
-        "and the feature layout of each (JSON). Replace any map with a painted one plus its layout.");
+        "Write the key wrinkle maps (neutral + one per wrinkling Action Unit and side: AU1L, AU1R, ..., AU17;\n"
+        "tangent-space normal maps, PNG) and the feature layout of each (JSON). Replace any map with a painted\n"
+        "one plus its layout; a folder of emotion keys (neutral, joy, ..., surprise) works too.");
     sub->add_option("--out", args->out, "Output folder (created if missing; its parent must exist)")
         ->required();
     sub->add_option("--size", args->size, "Side of the square maps, 256..4096")->capture_default_str();

@@ -66,7 +66,7 @@ FrameTimes FrameTimeTotals::mean() const {
 
 std::string format_times(const LoadTimes& load, const FrameTimeTotals& frames) {
     std::string out = fmt::format(
-        "  load {:.0f} ms: face {:.0f}, rig {:.0f}, profiles + lines {:.0f}, 7 wrinkle keys {:.0f}, "
+        "  load {:.0f} ms: face {:.0f}, rig {:.0f}, profiles + lines {:.0f}, wrinkle keys {:.0f}, "
         "GL context {:.0f}, scene {:.0f}\n",
         load.total(), load.face_ms, load.rig_ms, load.profiles_ms, load.keys_ms, load.platform_ms,
         load.scene_ms);
@@ -288,7 +288,7 @@ expression::FaceState Session::face_state(const expression::EmotionMix& mix) con
 }
 
 void Session::update(const expression::FaceState& state) {
-    scene_->update(state.faps, render::key_weights(state.mix));
+    scene_->update(state.faps, render::key_weights(assets_->keys, state));
     last_.scene = scene_->last_times();
     const auto fp = assets_->rig->feature_points(state.faps);
     for (int i = 0; i < expression::kFeatureCount; ++i)

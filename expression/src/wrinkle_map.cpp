@@ -13,9 +13,6 @@
 namespace emoface::expression {
 namespace {
 
-constexpr std::array<const char*, kWrinkleKeyCount> kKeyNames = {
-    "neutral", "joy", "sadness", "anger", "fear", "disgust", "surprise"};
-
 // ---------------------------------------------------------------- loading
 
 using detail::JsonReader;
@@ -94,6 +91,7 @@ struct Stroke {
     float depth, sigma, taper, side;
     float swell_phase;  // where along the swell noise this stroke starts
     bool fine;          // a fine secondary line: a plain valley, no shoulders
+    float split = 0.0f;  // +1 / -1: only the face's left / right half of it (an `across` wrinkle on one side)
     glm::vec2 box_min, box_max;
 };
 
@@ -225,10 +223,12 @@ Stroke make_stroke(WrinkleProfile profile, std::vector<glm::vec2> polyline, floa
     return s;
 }
 
-std::vector<Stroke> resolve_strokes(const std::vector<WrinkleSpec>& specs, const FoldShape& shape,
-                                    const FeatureLayout& layout) {
+// Appends the strokes of `specs` at `layout`, depths times `scale`, each
+// limited to one half of the face by `split` (0: whole).
+void resolve_strokes(const std::vector<WrinkleSpec>& specs, const FoldShape& shape, const FeatureLayout& layout,
+                     float scale, float split, std::vector<Stroke>& strokes) {
     const float unit = layout.face_unit();
-    std::vector<Stroke> strokes;
+    const std::size_t first = strokes.size();
     for (const WrinkleSpec& spec : specs) {
         std::vector<glm::vec2> base;
         for (const AnchoredPoint& p : spec.points) base.push_back(resolve(p, layout, unit));
@@ -241,12 +241,12 @@ std::vector<Stroke> resolve_strokes(const std::vector<WrinkleSpec>& specs, const
                                 ? 6.0f * wide * sigma
                                 : (shape.shoulder_offset + 3.0f * shape.shoulder_width) * wide * sigma;
         if (curve.size() == 1) {  // a round mark: no along-the-fold shape
-            strokes.push_back(make_stroke(spec.profile, curve, spec.depth * unit, sigma, 0.0f, spec.side, 0.0f,
-                                          false, 3.0f * sigma));
+            strokes.push_back(make_stroke(spec.profile, curve, scale * spec.depth * unit, sigma, 0.0f, spec.side,
+                                          0.0f, false, 3.0f * sigma));
             continue;
         }
         const bool varied = spec.count > 1;
-        float depth = spec.depth;
+        float depth = scale * spec.depth;
         glm::vec2 shift{0.0f};
         for (int copy = 0; copy < spec.count; ++copy, depth *= spec.depth_falloff) {
             // Parallel folds differ: spacing, length and depth each vary a
@@ -280,7 +280,7 @@ std::vector<Stroke> resolve_strokes(const std::vector<WrinkleSpec>& specs, const
                                           spec.side, phase, false, reach));
         }
     }
-    return strokes;
+    for (std::size_t i = first; i < strokes.size(); ++i) strokes[i].split = split;
 }
 
 // A Gaussian that reaches exactly zero at 3 sigma, so skin away from a
@@ -420,6 +420,58 @@ struct WrinkleArea {
     }
 };
 
+// The face's midline, x at each image row: the polyline through the midline
+// points the face has; a wrinkle `across` it given to one side fades over
+// `blend` on either side of it, the two sides' weights summing to 1.
+struct Midline {
+    std::vector<glm::vec2> points;  // sorted by y
+    float blend = 0.0f;
+    explicit Midline(const FeatureLayout& layout) {
+        for (const char* id : {"11.1", "8.1", "8.2", "2.10", "2.1"}) {
+            const int i = fap::feature_point_index(id);
+            if (layout.present[i]) points.push_back(layout.points[i]);
+        }
+        std::sort(points.begin(), points.end(), [](glm::vec2 a, glm::vec2 b) { return a.y < b.y; });
+        blend = 0.04f * layout.face_unit();
+    }
+    float x_at(float y) const {
+        if (points.empty()) return 0.5f;
+        if (y <= points.front().y) return points.front().x;
+        for (size_t i = 0; i + 1 < points.size(); ++i)
+            if (y <= points[i + 1].y) {
+                const float span = points[i + 1].y - points[i].y;
+                const float t = span > 0.0f ? (y - points[i].y) / span : 0.0f;
+                return points[i].x + t * (points[i + 1].x - points[i].x);
+            }
+        return points.back().x;
+    }
+    // The share of a wrinkle at `p` that belongs to `split`'s side (the
+    // face's left is the image's right).
+    float weight(glm::vec2 p, float split) const {
+        if (split == 0.0f) return 1.0f;
+        return smoothstep01(0.5f + split * (p.x - x_at(p.y)) / (2.0f * blend));
+    }
+};
+
+// The strokes of a key's sources at `layout`.
+std::vector<Stroke> key_strokes(const WrinkleLibrarySpec& spec, const WrinkleSources& sources,
+                                const FeatureLayout& layout) {
+    std::vector<Stroke> strokes;
+    for (const WrinkleSource& source : sources) {
+        const AuWrinkles* au = spec.find(source.au);
+        if (!au || source.intensity <= 0.0f) continue;
+        // A side's wrinkles stay on its half (a glabella furrow's shoulder
+        // fades out at the midline), so a one-sided AU leaves the other half
+        // flat and the two halves of an AU sum to the whole AU.
+        const bool left = source.side != AuSide::Right, right = source.side != AuSide::Left;
+        if (left) resolve_strokes(au->left, spec.fold, layout, source.intensity, 1.0f, strokes);
+        if (right) resolve_strokes(au->right, spec.fold, layout, source.intensity, -1.0f, strokes);
+        const float split = source.side == AuSide::Both ? 0.0f : (left ? 1.0f : -1.0f);
+        resolve_strokes(au->across, spec.fold, layout, source.intensity, split, strokes);
+    }
+    return strokes;
+}
+
 // Rows on the shared pool, a few at a time; each row is written by one call.
 template <typename RowFn>
 void for_each_row_band(int rows, RowFn&& fn) {
@@ -430,19 +482,43 @@ void for_each_row_band(int rows, RowFn&& fn) {
 
 }  // namespace
 
-const char* wrinkle_key_name(WrinkleKey key) { return kKeyNames[static_cast<int>(key)]; }
+const AuWrinkles* WrinkleLibrarySpec::find(int au) const {
+    for (const AuWrinkles& a : action_units)
+        if (a.au == au) return &a;
+    return nullptr;
+}
 
 WrinkleLibrarySpec load_wrinkle_spec(const std::string& path) {
     return detail::read_json_file(path, [](JsonReader& root) {
         root.comment("about");
         WrinkleLibrarySpec spec;
-        JsonReader emotions = root.object("emotions");
-        for (int key = 0; key < kWrinkleKeyCount; ++key) {
-            if (!emotions.has(kKeyNames[key])) continue;
-            for (const JsonReader& item : emotions.at(kKeyNames[key]).elements())
-                spec.wrinkles[key].push_back(read_wrinkle(item));
+        JsonReader units = root.object("action_units");
+        for (auto& [name, value] : units.entries()) {
+            std::string error;
+            const std::optional<AuTerm> term = parse_au_term(name, &error);
+            if (!term || term->side != AuSide::Both)
+                fail<InputError>("expression: {}: expected an AU such as \"AU4\" as the key (its sides are its "
+                                 "\"left\" and \"right\" lists), found \"{}\"",
+                                 value.loc().str(), name);
+            if (spec.find(term->number))
+                fail<InputError>("expression: {}: expected each AU once, found AU{} again", value.loc().str(),
+                                 term->number);
+            JsonReader au = value.as_object();
+            au.comment("why");
+            AuWrinkles w;
+            w.au = term->number;
+            const auto read_list = [&](const char* key, std::vector<WrinkleSpec>& out) {
+                if (!au.has(key)) return;
+                for (const JsonReader& item : au.at(key).elements()) out.push_back(read_wrinkle(item));
+            };
+            read_list("left", w.left);
+            read_list("right", w.right);
+            read_list("across", w.across);
+            au.finish();
+            if (w.left.empty() && w.right.empty() && w.across.empty())
+                au.fail("wrinkles in \"left\", \"right\" or \"across\"");
+            spec.action_units.push_back(std::move(w));
         }
-        emotions.finish();
         if (root.has("fold_shape")) {
             JsonReader f = root.object("fold_shape");
             f.comment("why");
@@ -482,12 +558,26 @@ WrinkleLibrarySpec load_wrinkle_spec(const std::string& path) {
     });
 }
 
-std::vector<float> render_height_field(const WrinkleLibrarySpec& spec, WrinkleKey key,
+WrinkleRegion wrinkle_region(const WrinkleLibrarySpec& spec, const WrinkleSources& sources,
+                             const FeatureLayout& layout) {
+    if (sources.empty()) return {};
+    WrinkleRegion r{glm::vec2(1.0f), glm::vec2(0.0f)};
+    for (const Stroke& s : key_strokes(spec, sources, layout)) {
+        r.min = glm::min(r.min, s.box_min);
+        r.max = glm::max(r.max, s.box_max);
+    }
+    r.min = glm::clamp(r.min, 0.0f, 1.0f);
+    r.max = glm::clamp(r.max, 0.0f, 1.0f);
+    return r;
+}
+
+std::vector<float> render_height_field(const WrinkleLibrarySpec& spec, const WrinkleSources& sources,
                                        const FeatureLayout& layout, int size) {
     if (size < 16 || size > 8192)
         fail<InputError>("expression: render_height_field(): size must be in [16, 8192], found {}", size);
-    std::vector<Stroke> strokes = resolve_strokes(spec.wrinkles[static_cast<int>(key)], spec.fold, layout);
+    std::vector<Stroke> strokes = key_strokes(spec, sources, layout);
     const WrinkleArea area(layout);
+    const Midline midline(layout);
     for (Stroke& s : strokes) {
         // A fold fades along its length as its centreline nears the hair,
         // so it thins out before the hairline instead of being cut there.
@@ -499,7 +589,7 @@ std::vector<float> render_height_field(const WrinkleLibrarySpec& spec, WrinkleKe
                                      return std::all_of(s.keep.begin(), s.keep.end(), [](float k) { return k <= 0.0f; });
                                  }),
                   strokes.end());
-    const bool detail = key == WrinkleKey::Neutral && spec.neutral_detail.amplitude > 0.0f;
+    const bool detail = sources.empty() && spec.neutral_detail.amplitude > 0.0f;
     const SkinMask mask(layout);
     const float unit = layout.face_unit();
     std::vector<float> height(static_cast<size_t>(size) * size, 0.0f);
@@ -511,7 +601,11 @@ std::vector<float> render_height_field(const WrinkleLibrarySpec& spec, WrinkleKe
             if (y < s.box_min.y || y > s.box_max.y) continue;
             const int c0 = std::max(0, static_cast<int>(std::floor(s.box_min.x * size)));
             const int c1 = std::min(size - 1, static_cast<int>(std::ceil(s.box_max.x * size)));
-            for (int col = c0; col <= c1; ++col) out[col] += stroke_height(s, spec.fold, unit, {(col + 0.5f) * inv, y});
+            for (int col = c0; col <= c1; ++col) {
+                const glm::vec2 x{(col + 0.5f) * inv, y};
+                const float share = midline.weight(x, s.split);
+                if (share > 0.0f) out[col] += share * stroke_height(s, spec.fold, unit, x);
+            }
         }
         if (detail) {
             const SkinDetail& d = spec.neutral_detail;
@@ -533,13 +627,24 @@ std::vector<float> render_height_field(const WrinkleLibrarySpec& spec, WrinkleKe
 }
 
 NormalMap height_to_normal_map(const std::vector<float>& height, int size, float face_unit,
-                               const CavitySpec& cavity) {
+                               const CavitySpec& cavity, const WrinkleRegion& region) {
     // Heights and positions share normalised units; the cavity's full depth
     // is in face units.
     const float full_depth = cavity.full_depth * face_unit;
     NormalMap map;
     map.width = map.height = size;
     map.rgba.resize(static_cast<size_t>(size) * size * 4);
+    // Outside the region the height is 0 and so are its differences: flat.
+    for (size_t i = 0; i < map.rgba.size(); i += 4) {
+        map.rgba[i] = map.rgba[i + 1] = 128;
+        map.rgba[i + 2] = map.rgba[i + 3] = 255;
+    }
+    if (region.empty()) return map;
+    // One pixel more on each side: a difference reaches its neighbours.
+    const int c0 = std::max(0, static_cast<int>(std::floor(region.min.x * size)) - 1);
+    const int c1 = std::min(size - 1, static_cast<int>(std::ceil(region.max.x * size)) + 1);
+    const int r0 = std::max(0, static_cast<int>(std::floor(region.min.y * size)) - 1);
+    const int r1 = std::min(size - 1, static_cast<int>(std::ceil(region.max.y * size)) + 1);
     const float scale = static_cast<float>(size) * 0.5f;  // central difference over 2 px of 1/size
     const auto at = [&](int r, int c) {
         r = std::clamp(r, 0, size - 1);
@@ -549,8 +654,9 @@ NormalMap height_to_normal_map(const std::vector<float>& height, int size, float
     const auto encode = [](float v) {
         return static_cast<std::uint8_t>(std::clamp(std::lround((0.5f + 0.5f * v) * 255.0f), 0L, 255L));
     };
-    for_each_row_band(size, [&](int r) {
-        for (int c = 0; c < size; ++c) {
+    for_each_row_band(r1 - r0 + 1, [&](int band_row) {
+        const int r = r0 + band_row;
+        for (int c = c0; c <= c1; ++c) {
             const float dx = (at(r, c + 1) - at(r, c - 1)) * scale;
             const float dy = (at(r + 1, c) - at(r - 1, c)) * scale;
             const float len = std::sqrt(dx * dx + dy * dy + 1.0f);
@@ -567,11 +673,12 @@ NormalMap height_to_normal_map(const std::vector<float>& height, int size, float
     return map;
 }
 
-NormalMap generate_wrinkle_map(const WrinkleLibrarySpec& spec, WrinkleKey key,
+NormalMap generate_wrinkle_map(const WrinkleLibrarySpec& spec, const WrinkleSources& sources,
                                const FeatureLayout& layout, int size) {
     if (size < 256 || size > 4096)
         fail<InputError>("expression: generate_wrinkle_map(): size must be in [256, 4096], found {}", size);
-    return height_to_normal_map(render_height_field(spec, key, layout, size), size, layout.face_unit(), spec.cavity);
+    return height_to_normal_map(render_height_field(spec, sources, layout, size), size, layout.face_unit(),
+                                spec.cavity, wrinkle_region(spec, sources, layout));
 }
 
 }  // namespace emoface::expression

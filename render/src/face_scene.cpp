@@ -79,12 +79,14 @@ expression::FeatureLayout posed_layout(const expression::Face& face,
 }
 
 WrinkleKey make_wrinkle_key(const expression::Face& face, const expression::FaceRig& rig,
-                            const expression::WrinkleLibrarySpec& spec, expression::WrinkleKey key,
-                            const expression::FapValues& pose, int size, WrinkleLayout layout) {
+                            const expression::WrinkleLibrarySpec& spec, std::string name,
+                            const expression::WrinkleSources& sources, const expression::FapValues& pose,
+                            int size, WrinkleLayout layout) {
     WrinkleKey k;
-    k.name = expression::wrinkle_key_name(key);
+    k.name = std::move(name);
     k.layout = posed_layout(face, rig, pose, layout);
-    k.map = expression::generate_wrinkle_map(spec, key, k.layout, size);
+    k.map = expression::generate_wrinkle_map(spec, sources, k.layout, size);
+    k.region = expression::wrinkle_region(spec, sources, k.layout);
     return k;
 }
 
@@ -119,6 +121,10 @@ FaceScene::FaceScene(Platform& platform, const expression::Face& face,
       layout_kind_(options.layout), lines_(std::move(lines)), params_(options.morph),
       frames_(options.frames) {
     params_.normal_map = true;
+    // Where keys say nothing the skin is flat: AU keys add their slopes and
+    // cavities to the neutral key's (weights may sum over 1). 128/255 is
+    // what a flat pixel holds, so flat key pixels cancel exactly.
+    params_.rest = {128.0f / 255.0f, 128.0f / 255.0f, 1.0f, 1.0f};
     if (layout_kind_ == WrinkleLayout::Anchored && frames_ == WrinkleFrames::Shader)
         fail("render: FaceScene: WrinkleFrames::Shader has the projective layout's closed form; "
              "expected WrinkleFrames::Mesh with the anchored layout");
@@ -140,9 +146,16 @@ FaceScene::FaceScene(Platform& platform, const expression::Face& face,
         if (k.map.width != size_w || k.map.height != size_h)
             fail<InputError>("render: FaceScene: key '{}' is {}x{}, key '{}' {}x{}", k.name,
                              k.map.width, k.map.height, keys[0].name, size_w, size_h);
-        maps.push_back({k.map.rgba.data(),
-                        to_morph_layout(expression::layout_segments(lines_, k.layout)), size_w,
-                        size_h});
+        morph::KeyMap map;
+        map.pixels = k.map.rgba.data();
+        map.layout = to_morph_layout(expression::layout_segments(lines_, k.layout));
+        map.width = size_w;
+        map.height = size_h;
+        // A key without wrinkles at all is rest everywhere: one pixel of it.
+        const expression::WrinkleRegion r =
+            k.region.empty() ? expression::WrinkleRegion{glm::vec2(0.0f), glm::vec2(1.0f / float(size_w))} : k.region;
+        map.region = {r.min.x, r.min.y, r.max.x, r.max.y};
+        maps.push_back(std::move(map));
     }
     morpher_ = std::make_unique<morph::Morpher>(size_w, size_h, morph::PixelFormat::Rgba8,
                                                 std::move(maps), options.backend);

@@ -150,12 +150,13 @@ protected:
         assets_ = render::load_face_assets(std::move(face), EMOFACE_DATA_DIR, ao).release();
         generated_ = new std::vector<render::WrinkleKey>(assets_->keys);
 
-        // Paint the keys in the OBJ's UV space and use them as --wrinkles DIR does.
-        std::vector<render::WrinkleKey> painted = assets_->keys;
-        for (std::size_t k = 0; k < painted.size(); ++k) {
+        // Paint the thesis's seven emotion keys in the OBJ's UV space and use
+        // them as --wrinkles DIR does (a folder of emotion keys still works).
+        std::vector<render::WrinkleKey> painted;
+        for (const char* name : {"neutral", "joy", "sadness", "anger", "fear", "disgust", "surprise"}) {
             Canvas canvas;
-            paint(expression::WrinkleKey(k), canvas);
-            painted[k].map = canvas.map();
+            paint(name, canvas);
+            painted.push_back({name, canvas.map(), assets_->keys.front().layout, {}});
         }
         render::write_wrinkle_keys(dir + "/keys", painted);
         assets_->keys = render::read_wrinkle_keys(dir + "/keys", assets_->lines);
@@ -187,31 +188,25 @@ protected:
     // anger: two vertical grooves between the brows; surprise: three
     // horizontal grooves across the forehead; joy: a round bump on each
     // cheek (5.3, 5.4). The other keys stay flat.
-    static void paint(expression::WrinkleKey key, Canvas& canvas) {
+    static void paint(const std::string& key, Canvas& canvas) {
         const expression::Face& f = assets_->face;
         const glm::vec2 in_l = painted_at(f, "4.1"), in_r = painted_at(f, "4.2");
         const float gap = glm::distance(in_l, in_r);
         const glm::vec2 up(0.0f, -1.0f);  // up the face = up the painted image
-        switch (key) {
-            case expression::WrinkleKey::Anger:
+        if (key == "anger") {
                 for (const float t : {0.3f, 0.7f}) {
                     const glm::vec2 base = glm::mix(in_r, in_l, t);
                     canvas.stroke(base + 0.05f * gap * up, base + 0.5f * gap * up, -0.006f, 2.5f);
                 }
-                break;
-            case expression::WrinkleKey::Surprise: {
+        } else if (key == "surprise") {
                 const glm::vec2 mid_l = painted_at(f, "4.3"), mid_r = painted_at(f, "4.4");
                 for (const float h : {0.35f, 0.6f, 0.85f})
                     canvas.stroke(mid_r + h * gap * up, mid_l + h * gap * up, -0.005f, 3.0f);
-                break;
-            }
-            case expression::WrinkleKey::Joy:
+        } else if (key == "joy") {
                 for (const char* id : {"5.3", "5.4"}) {
                     const glm::vec2 c = painted_at(f, id);
                     canvas.stroke(c, c, 0.012f, 7.0f);
                 }
-                break;
-            default: break;
         }
     }
 
@@ -239,7 +234,7 @@ protected:
                                    const std::vector<float>* key_weights = nullptr) {
         const expression::FaceState state =
             expression::face_state(expression::parse_emotion_mix(mix), assets_->emotions);
-        scene_->update(state.faps, key_weights ? *key_weights : render::key_weights(state.mix));
+        scene_->update(state.faps, key_weights ? *key_weights : render::key_weights(assets_->keys, state));
         platform_->begin_frame();
         render::DrawOptions d = draw_options(wrinkles);
         // A measuring light is the only light: the thesis's one-light
@@ -370,8 +365,8 @@ TEST_F(AnchoredLayout, PaintedMarksSitWherePainted) {
     const render::Light front = measuring_light({0.0f, 0.0f, 1.0f});
     // Against the same pose with the (flat) neutral key alone, so that
     // every change is the painted joy key's.
-    std::vector<float> neutral_only(expression::kWrinkleKeyCount, 0.0f);
-    neutral_only[0] = 1.0f;
+    std::vector<float> neutral_only(assets_->keys.size(), 0.0f);
+    neutral_only[0] = 1.0f;  // read_wrinkle_keys puts neutral first
     const render::ImageRGBA8 with = draw("joy", true, &front);
     const render::ImageRGBA8 without = draw("joy", true, &front, &neutral_only);
     double total = 0, in_windows = 0;

@@ -55,7 +55,7 @@ protected:
     }
 
     static render::ImageRGBA8 draw(const expression::FaceState& state) {
-        scene_->update(state.faps, render::key_weights(state.mix));
+        scene_->update(state.faps, render::key_weights(assets_->keys, state));
         render::DrawOptions d;
         d.camera = scene_->frontal_camera(1.0f);
         d.light = scene_->portrait_light();
@@ -126,7 +126,7 @@ TEST_F(Golden, ToleranceSeparatesWrinklesFromNoWrinkles) {
     const expression::FaceState anger =
         expression::face_state(expression::parse_emotion_mix("anger"), assets_->emotions);
     const render::ImageRGBA8 with = draw(anger);
-    scene_->update(anger.faps, render::key_weights(anger.mix));
+    scene_->update(anger.faps, render::key_weights(assets_->keys, anger));
     render::DrawOptions d;
     d.camera = scene_->frontal_camera(1.0f);
     d.light = scene_->portrait_light();

@@ -1,11 +1,30 @@
 #include "emoface/render/wrinkle_keys_io.h"
 
+#include <algorithm>
 #include <filesystem>
 
 #include "emoface/common/error.h"
+#include "emoface/render/face_assets.h"
 #include "emoface/render/image_io.h"
 
 namespace emoface::render {
+
+namespace {
+
+// The box of the pixels that are not flat skin; the whole map has none.
+expression::WrinkleRegion painted_region(const expression::NormalMap& map) {
+    int x0 = map.width, y0 = map.height, x1 = -1, y1 = -1;
+    for (int y = 0; y < map.height; ++y)
+        for (int x = 0; x < map.width; ++x) {
+            const std::uint8_t* p = &map.rgba[(std::size_t(y) * map.width + x) * 4];
+            if (p[0] == 128 && p[1] == 128 && p[2] == 255 && p[3] == 255) continue;
+            x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+        }
+    if (x1 < 0) return {glm::vec2(0.0f), glm::vec2(0.0f)};
+    return {{float(x0) / map.width, float(y0) / map.height}, {float(x1 + 1) / map.width, float(y1 + 1) / map.height}};
+}
+
+}  // namespace
 
 void write_wrinkle_keys(const std::string& folder, const std::vector<WrinkleKey>& keys) {
     namespace fs = std::filesystem;
@@ -24,12 +43,27 @@ std::vector<WrinkleKey> read_wrinkle_keys(const std::string& folder,
     if (!fs::is_directory(folder))
         fail<InputError>("render: {}: expected a folder of wrinkle maps (as `emoface wrinkles` writes), found none",
                          folder);
+    std::vector<std::string> names;
+    for (const fs::directory_entry& entry : fs::directory_iterator(folder)) {
+        const fs::path path = entry.path();
+        if (path.extension() != ".png") continue;
+        const std::string name = path.stem().string();
+        if (!key_driver(name))
+            fail<InputError>("render: {}: expected a key map named neutral, an emotion (joy, ...) or an AU term "
+                             "(AU6L, AU17), found '{}'",
+                             path.string(), name);
+        names.push_back(name);
+    }
+    if (std::find(names.begin(), names.end(), "neutral") == names.end())
+        fail<InputError>("render: {}.png: missing wrinkle map", (fs::path(folder) / "neutral").string());
+    std::sort(names.begin(), names.end(), [](const std::string& a, const std::string& b) {
+        return (a == "neutral") != (b == "neutral") ? a == "neutral" : a < b;
+    });
     std::vector<WrinkleKey> keys;
-    for (int k = 0; k < expression::kWrinkleKeyCount; ++k) {
+    for (const std::string& name : names) {
         WrinkleKey key;
-        key.name = expression::wrinkle_key_name(static_cast<expression::WrinkleKey>(k));
+        key.name = name;
         const std::string stem = (fs::path(folder) / key.name).string();
-        if (!fs::exists(stem + ".png")) fail<InputError>("render: {}.png: missing wrinkle map", stem);
         if (!fs::exists(stem + ".layout.json"))
             fail<InputError>("render: {}.layout.json: missing layout of {}.png", stem, key.name);
         const ImageRGBA8 image = read_image_rgba8(stem + ".png");
@@ -48,6 +82,8 @@ std::vector<WrinkleKey> read_wrinkle_keys(const std::string& folder,
                 if (!key.layout.present[point])
                     fail<InputError>("render: {}.layout.json: lacks feature point {}, which the morph's lines use",
                                      stem, fap::feature_points()[point].id);
+        // The neutral key is the whole map (the skin under every frame).
+        if (name != "neutral") key.region = painted_region(key.map);
         keys.push_back(std::move(key));
     }
     return keys;

@@ -1,8 +1,11 @@
 #pragma once
-// The wrinkle library: per emotion, the wrinkles of thesis chapter 2.3,
-// written as curves placed relative to feature points (data/expression/
-// wrinkles.json), rendered as a height field at a feature layout and turned
-// into a tangent-space normal map.
+// The wrinkle library: per FACS Action Unit, the wrinkles its muscle makes
+// (per side for a bilateral AU), written as curves placed relative to
+// feature points (data/expression/wrinkles.json), rendered as a height field
+// at a feature layout and turned into a tangent-space normal map. A key map
+// shows some AUs' wrinkles (one AU on one side for the frame's AU keys; an
+// emotion's prototype AUs at their intensities for the thesis's emotion keys)
+// or, with none, the neutral skin's fine detail.
 //
 // Normal-map convention: RGB = 0.5 + 0.5 n, with n.x along the image's
 // columns (right), n.y along its rows (DOWN, i.e. "DirectX" or Y- green) and
@@ -15,15 +18,10 @@
 
 #include <glm/vec2.hpp>
 
+#include "emoface/expression/action_units.h"
 #include "emoface/expression/feature_layout.h"
 
 namespace emoface::expression {
-
-// The six Ekman emotions in the order the project uses everywhere
-// (FAP 2 codes 1..6), plus neutral (code 0) for the wrinkle maps.
-enum class WrinkleKey { Neutral, Joy, Sadness, Anger, Fear, Disgust, Surprise };
-constexpr int kWrinkleKeyCount = 7;
-const char* wrinkle_key_name(WrinkleKey key);  // "neutral", "joy", ...
 
 enum class WrinkleProfile {
     Groove,  // a Gaussian valley across the curve
@@ -89,16 +87,46 @@ struct SkinDetail {
     int octaves = 3;
 };
 
+// The wrinkles one AU makes at its full intensity (FACS "E").
+struct AuWrinkles {
+    int au = 0;
+    std::vector<WrinkleSpec> left, right;  // on that side of the face
+    std::vector<WrinkleSpec> across;       // over the midline: split softly between the sides
+};
+
 struct WrinkleLibrarySpec {
-    std::array<std::vector<WrinkleSpec>, kWrinkleKeyCount> wrinkles;  // by WrinkleKey
+    std::vector<AuWrinkles> action_units;  // in file order, each AU once
     SkinDetail neutral_detail;
     FoldShape fold;
     CavitySpec cavity;
+    const AuWrinkles* find(int au) const;  // nullptr: the AU makes no wrinkles
 };
 
-// Loads data/expression/wrinkles.json; errors name the file, emotion and
-// wrinkle that is wrong.
+// One AU's wrinkles in a key map: the side's list plus its half of the
+// `across` wrinkles (AuSide::Both: all of them, whole), depths times
+// `intensity`.
+struct WrinkleSource {
+    int au = 0;
+    AuSide side = AuSide::Both;
+    float intensity = 1.0f;
+};
+// What a key map shows: the sources' wrinkles; none: the neutral skin's
+// fine detail (wrinkles.json "neutral_skin_detail").
+using WrinkleSources = std::vector<WrinkleSource>;
+
+// Loads data/expression/wrinkles.json; errors name the file, AU, side and
+// wrinkle that is wrong ("action_units.AU6.left[1].depth: expected ...").
 WrinkleLibrarySpec load_wrinkle_spec(const std::string& path);
+
+// The part of a map that a key's wrinkles touch, in normalised texture
+// coordinates (x right, y down), the fold's full reach included: outside it
+// the key's map is exactly flat. The whole map for the neutral key.
+struct WrinkleRegion {
+    glm::vec2 min{0.0f}, max{1.0f};
+    bool empty() const { return !(max.x > min.x && max.y > min.y); }
+};
+WrinkleRegion wrinkle_region(const WrinkleLibrarySpec& spec, const WrinkleSources& sources,
+                             const FeatureLayout& layout);
 
 struct NormalMap {
     int width = 0;
@@ -107,22 +135,28 @@ struct NormalMap {
 };
 
 // Height field (face units, 0 = flat skin) of one key's wrinkles at `layout`,
-// size x size samples at pixel centres. Deterministic. Every wrinkle fades
-// out below the hairline (feature points 11.2, 11.1, 11.3) and before the
-// map's edge, so no fold sits on the hair or is cut off.
-std::vector<float> render_height_field(const WrinkleLibrarySpec& spec, WrinkleKey key,
+// size x size samples at pixel centres, computed only inside the key's
+// region (0 elsewhere). Deterministic. Every wrinkle fades out below the
+// hairline (feature points 11.2, 11.1, 11.3) and before the map's edge, so
+// no fold sits on the hair or is cut off. A side's wrinkles, and the half
+// of an `across` wrinkle given to one side, are weighted by a smooth step
+// across the midline (the polyline through 11.1, 8.1, 8.2, 2.10, 2.1 where
+// present), so a one-sided AU leaves the other half flat and the two sides
+// of an AU sum to the whole AU.
+std::vector<float> render_height_field(const WrinkleLibrarySpec& spec, const WrinkleSources& sources,
                                        const FeatureLayout& layout, int size);
 
 // Tangent-space normal map of a height field (see the convention above),
 // with the cavity in alpha: exactly 255 where the height is >= 0, lower in
 // valleys (heights in normalised texture units; face_unit scales
 // cavity.full_depth to them). Where the height field is locally flat the
-// pixel is exactly (128, 128, 255, 255).
+// pixel is exactly (128, 128, 255, 255), and outside `region` (where the
+// height must be 0) it is written so without looking.
 NormalMap height_to_normal_map(const std::vector<float>& height, int size, float face_unit,
-                               const CavitySpec& cavity = {});
+                               const CavitySpec& cavity = {}, const WrinkleRegion& region = {});
 
 // render_height_field + height_to_normal_map. size in [256, 4096].
-NormalMap generate_wrinkle_map(const WrinkleLibrarySpec& spec, WrinkleKey key,
+NormalMap generate_wrinkle_map(const WrinkleLibrarySpec& spec, const WrinkleSources& sources,
                                const FeatureLayout& layout, int size);
 
 }  // namespace emoface::expression

@@ -1,10 +1,12 @@
 #pragma once
 // What the pipeline needs for one face, loaded once: the face, its rig, the
-// emotion and viseme profiles, the morph's feature lines and the seven key
-// wrinkle maps (neutral + six emotions, each made at its own expression's
-// layout, DESIGN.md "Texture layouts"). FaceScene draws frames from it.
+// emotion and viseme profiles, the morph's feature lines, the wrinkle
+// library and the key wrinkle maps (neutral + one per wrinkling AU and side,
+// each made at its own AU's layout, DESIGN.md "Texture layouts"; or painted
+// ones). FaceScene draws frames from it.
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,13 +25,14 @@ struct FaceAssets {
     expression::EmotionProfiles emotions;
     expression::VisemeProfiles visemes;
     std::vector<expression::FeatureLine> lines;  // those the face has both ends of
-    std::vector<WrinkleKey> keys;                // by expression::WrinkleKey
+    expression::WrinkleLibrarySpec wrinkles;     // data/expression/wrinkles.json
+    std::vector<WrinkleKey> keys;                // "neutral" first, then by name (key_weights)
     WrinkleLayout layout = WrinkleLayout::Projective;  // the texture space of the keys
     // Wall-clock milliseconds of loading them (for the commands' reports).
     struct Times {
         double rig_ms = 0;       // the rig's influence weights
         double profiles_ms = 0;  // emotion/viseme profiles, feature lines, wrinkle spec
-        double keys_ms = 0;      // the seven key wrinkle maps (generated or read)
+        double keys_ms = 0;      // the key wrinkle maps (generated or read)
     } times;
 };
 
@@ -61,9 +64,35 @@ std::unique_ptr<FaceAssets> load_face_assets(expression::Face face, const std::s
 std::unique_ptr<FaceAssets> load_default_face_assets(const std::string& data_dir,
                                                      const FaceAssetsOptions& options = {});
 
-// The key weights of a mix, in expression::WrinkleKey order: neutral
-// (1 - sum), then joy .. surprise.
-std::vector<float> key_weights(const expression::EmotionMix& mix);
+// What drives a wrinkle key, read from its name: "neutral", an emotion name
+// ("joy") or an AU term ("AU6L", "AU6R"; "AU17" for a midline AU or both
+// sides of one). nullopt for any other name.
+struct KeyDriver {
+    enum class Kind { Neutral, Emotion, ActionUnit } kind = Kind::Neutral;
+    expression::Emotion emotion = expression::Emotion::Joy;
+    expression::AuTerm au;
+};
+std::optional<KeyDriver> key_driver(const std::string& name);
+
+// The weight of each key in a frame, from what drives it: an AU key the
+// frame's AU intensity on its side (both sides: their mean); an emotion key
+// the mix's weight (scaled down if the emotions sum over 1); neutral
+// 1 - the sum of the emotion keys' weights (AU keys take nothing from it:
+// their wrinkles add to the neutral skin, the morph's rest value is flat
+// skin). The one place a key's weight is decided.
+// Weights under kNegligibleKeyWeight are 0 (a key at 0 costs nothing).
+inline constexpr float kNegligibleKeyWeight = 1.0f / 512.0f;
+std::vector<float> key_weights(const std::vector<WrinkleKey>& keys, const expression::FaceState& state);
+
+// The generated key set of `assets` (FaceAssetsOptions without read_keys):
+// "neutral", then one key per wrinkling AU of the library, per side for a
+// bilateral AU ("AU1L", "AU1R", ..., "AU17"), each at its AU's layout (the
+// AU's side at full intensity through the rig).
+std::vector<WrinkleKey> make_action_unit_keys(const FaceAssets& assets, int size);
+// An emotion's key (the thesis's figure 6.4): the union of its prototype
+// AUs' wrinkles at their intensities, at the emotion's layout; nullopt: the
+// neutral key.
+WrinkleKey make_emotion_key(const FaceAssets& assets, std::optional<expression::Emotion> emotion, int size);
 
 // A scene on the assets (which must outlive it), in the assets' layout
 // (options.layout is replaced by it).

@@ -30,11 +30,16 @@
 namespace emoface::render {
 
 // A key of the wrinkle morph: a normal map (RGBA8, rows top first, the
-// convention of expression/wrinkle_map.h) and the layout it was made at.
+// convention of expression/wrinkle_map.h), the layout it was made at and the
+// region its wrinkles cover (normalised, in that layout; outside it the map
+// is flat skin, so the morph costs only the region). Its name says what
+// drives its weight (face_assets.h, key_weights): "neutral", an emotion
+// ("joy") or an AU term ("AU6L", "AU17").
 struct WrinkleKey {
     std::string name;
     expression::NormalMap map;
     expression::FeatureLayout layout;
+    expression::WrinkleRegion region;  // the whole map unless known smaller
 };
 
 // Which texture space the wrinkle maps live in (DESIGN.md "Texture layouts").
@@ -67,13 +72,14 @@ expression::FeatureLayout posed_layout(const expression::Face& face,
                                        const expression::FapValues& faps,
                                        WrinkleLayout layout = WrinkleLayout::Projective);
 
-// One key per (key, pose): the library's wrinkles of `key` generated at
-// posed_layout(face, rig, pose, layout) (pose: the key expression at full
-// intensity), size x size pixels.
+// The one key generator: the library's wrinkles of `sources` (none: the
+// neutral skin) generated at posed_layout(face, rig, pose, layout) (pose:
+// what makes those wrinkles, at the intensities of `sources`), size x size
+// pixels, rendered only inside their region.
 WrinkleKey make_wrinkle_key(const expression::Face& face, const expression::FaceRig& rig,
-                            const expression::WrinkleLibrarySpec& spec, expression::WrinkleKey key,
-                            const expression::FapValues& pose, int size,
-                            WrinkleLayout layout = WrinkleLayout::Projective);
+                            const expression::WrinkleLibrarySpec& spec, std::string name,
+                            const expression::WrinkleSources& sources, const expression::FapValues& pose,
+                            int size, WrinkleLayout layout = WrinkleLayout::Projective);
 
 // Where the skin's wrinkle UVs and tangent frames come from each frame.
 enum class WrinkleFrames {
@@ -120,7 +126,8 @@ public:
     FaceScene& operator=(const FaceScene&) = delete;
 
     // One frame: the face deformed by `faps`, the keys blended by
-    // `key_weights` (one per key, each >= 0, sum <= 1) onto the frame's layout.
+    // `key_weights` (one per key, each >= 0; face_assets.h key_weights) onto
+    // the frame's layout, flat skin where their weights sum under 1.
     // The layout first, then the morph is queued (on the GPU it overlaps
     // the CPU work that follows), then update_geometry(faps).
     void update(const expression::FapValues& faps, const std::vector<float>& key_weights);
