@@ -820,21 +820,32 @@ void Generator::place_feature_points(Face& face) {
         }
         set_vertex("9.3", best);
     }
-    // Ears: top, back, lobe and the contact points, from the ear's ellipse.
+    // Ears: top, back, lobe and the lower and upper contact with the head,
+    // at their places in the ear's own coordinates: the skin vertex on the
+    // side of the head nearest that side point (y, z).
     {
-        const double ye = p_.ear_centre_yz[0], ze = p_.ear_centre_yz[1];
-        const double ry = p_.ear_radii_yz[0], rz = p_.ear_radii_yz[1];
-        const double far = 200.0, near = 60.0;
         struct EarPoint {
             const char* left;
             const char* right;
-            double x, y, z;
-        } ears[] = {{"10.1", "10.2", far, ye + 0.9 * ry, ze},        {"10.3", "10.4", far, ye, ze - 0.9 * rz},
-                    {"10.5", "10.6", far, ye - 0.9 * ry, ze},        {"10.7", "10.8", near, ye - 0.55 * ry, ze + 0.8 * rz},
-                    {"10.9", "10.10", near, ye + 0.55 * ry, ze + 0.8 * rz}};
+            double a, s;
+        } ears[] = {{"10.1", "10.2", 0.97, -0.15}, {"10.3", "10.4", 0.15, -0.97}, {"10.5", "10.6", -0.97, 0.0},
+                    {"10.7", "10.8", -0.72, 0.9},  {"10.9", "10.10", 0.7, 0.85}};
         for (const EarPoint& e : ears) {
-            set_vertex(e.left, nearest_3d({e.x, e.y, e.z}));
-            set_vertex(e.right, nearest_3d({-e.x, e.y, e.z}));
+            const glm::dvec2 yz = shape_.ear_point(e.a, e.s);
+            for (const double side : {1.0, -1.0}) {
+                int best = 0;
+                double best_d = std::numeric_limits<double>::max();
+                for (int v = 0; v < skin_end; ++v) {
+                    const auto q = face.mesh.point(TriMesh::VertexHandle(v));
+                    if (q[0] * side < 40.0) continue;
+                    const double d = std::hypot(q[1] - yz[0], q[2] - yz[1]);
+                    if (d < best_d) {
+                        best_d = d;
+                        best = v;
+                    }
+                }
+                set_vertex(side > 0 ? e.left : e.right, best);
+            }
         }
     }
     // Mouth interior.

@@ -8,14 +8,15 @@ namespace {
 glm::dvec2 to_glm(const std::array<double, 2>& a) { return {a[0], a[1]}; }
 glm::dvec3 to_glm(const std::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
 
-Ellipsoid read_ellipsoid(JsonReader r) {
+// Reads an ellipsoid's keys; the caller may read more keys of the object, then finishes it.
+Ellipsoid read_ellipsoid(JsonReader& r) {
     Ellipsoid e;
     e.centre = to_glm(r.numbers<3>("centre"));
     e.radii = to_glm(r.numbers<3>("radii"));
     e.tilt_deg = r.number("tilt_deg", 0.0);
+    e.exponent = r.number_in("exponent", 2.0, 8.0, 2.0);
     for (int i = 0; i < 3; ++i)
         if (!(e.radii[i] > 0.0)) r.at("radii").fail("3 positive radii");
-    r.finish();
     return e;
 }
 
@@ -77,16 +78,35 @@ FaceParams read_face_params(const std::string& params_dir) {
         }
         {
             JsonReader r = top.object("head");
-            p.skull = read_ellipsoid(r.object("skull"));
-            p.lower_face = read_ellipsoid(r.object("lower_face"));
-            p.jaw = read_ellipsoid(r.object("jaw"));
+            for (JsonReader part : r.objects("parts")) {
+                HeadPart hp;
+                hp.name = part.string("name");
+                hp.is_capsule = part.has("from");
+                if (hp.is_capsule) {
+                    hp.capsule.from = to_glm(part.numbers<3>("from"));
+                    hp.capsule.to = to_glm(part.numbers<3>("to"));
+                    hp.capsule.radii = to_glm(part.numbers<2>("radii"));
+                    hp.capsule.mirror = part.boolean("mirror", false);
+                    if (!(hp.capsule.radii[0] > 0 && hp.capsule.radii[1] > 0)) part.at("radii").fail("2 positive radii");
+                } else {
+                    hp.shape = read_ellipsoid(part);
+                }
+                hp.blend = part.number_in("blend", 0.0, 100.0, 0.0);
+                part.finish();
+                p.head_parts.push_back(std::move(hp));
+            }
+            if (p.head_parts.empty()) r.at("parts").fail("at least one part");
             JsonReader neck = r.object("neck");
             p.neck_centre_z = neck.number("centre_z");
             p.neck_radii = to_glm(neck.numbers<2>("radii"));
             p.neck_top_y = neck.number("top_y");
+            p.neck_lean_deg = neck.number_in("lean_deg", -45.0, 45.0, 0.0);
             p.neck_blend = neck.number("blend");
             neck.finish();
-            p.blend = r.number("blend");
+            JsonReader shoulders = r.object("shoulders");
+            p.shoulders = read_ellipsoid(shoulders);
+            p.shoulders_blend = shoulders.number_in("blend", 0.0, 200.0);
+            shoulders.finish();
             r.finish();
         }
         {
@@ -181,6 +201,7 @@ FaceParams read_face_params(const std::string& params_dir) {
             JsonReader r = top.object("ears");
             p.ear_centre_yz = to_glm(r.numbers<2>("centre_yz"));
             p.ear_radii_yz = to_glm(r.numbers<2>("radii_yz"));
+            p.ear_tilt_deg = r.number_in("tilt_deg", -45.0, 45.0);
             p.ear_height = r.number("height");
             r.finish();
         }
@@ -224,6 +245,13 @@ FaceParams read_face_params(const std::string& params_dir) {
             p.brow_points = {to_glm(r.numbers<2>("inner")), to_glm(r.numbers<2>("peak")),
                              to_glm(r.numbers<2>("outer"))};
             p.brow_thickness = to_glm(r.numbers<3>("thickness"));
+            JsonReader h = r.object("hairs");
+            p.brow_hair_spacing = h.number_in("spacing", 0.2, 5.0);
+            p.brow_hair_width = h.number_in("width", 0.05, 2.0);
+            p.brow_hair_length = to_glm(h.numbers<2>("length"));
+            p.brow_medial_angle = h.number_in("medial_angle_deg", 0.0, 120.0);
+            p.brow_lateral_angle = h.number_in("lateral_angle_deg", 0.0, 60.0);
+            h.finish();
             r.finish();
         }
         {
@@ -233,6 +261,57 @@ FaceParams read_face_params(const std::string& params_dir) {
             p.sideburn_z = r.number("sideburn_z");
             p.sideburn_bottom_y = r.number("sideburn_bottom_y");
             p.hair_back_bottom_y = r.number("back_bottom_y");
+            p.hair_crown = to_glm(r.numbers<3>("crown"));
+            p.hairline_band = r.number_in("hairline_band", 0.0, 30.0);
+            p.hair_strand_width = r.number_in("strand_width", 0.05, 5.0);
+            p.hair_strand_length = r.number_in("strand_length", 0.5, 100.0);
+            p.hair_tip_lightening = r.number_in("tip_lightening", 0.0, 1.0);
+            r.finish();
+        }
+        {
+            JsonReader r = top.object("albedo");
+            auto& a = p.albedo;
+            a.pigment_variation = r.number_in("pigment_variation", 0.0, 0.5);
+            a.mottling = r.number_in("mottling", 0.0, 2.0);
+            for (JsonReader& f : r.objects("flush")) {
+                FaceParams::Flush fl;
+                fl.centre = to_glm(f.numbers<2>("centre"));
+                fl.size = to_glm(f.numbers<2>("size"));
+                if (!(fl.size[0] > 0 && fl.size[1] > 0)) f.at("size").fail("two widths > 0 (mm)");
+                fl.amount = f.number_in("amount", 0.0, 1.5);
+                f.finish();
+                a.flush.push_back(fl);
+            }
+            a.flush_breakup = r.number_in("flush_breakup", 0.0, 1.0);
+            a.ear_flush = r.number_in("ear_flush", 0.0, 1.5);
+            {
+                JsonReader f = r.object("freckles");
+                a.freckle_spacing = f.number_in("spacing_mm", 0.5, 100.0);
+                a.freckle_size = f.number_in("size_mm", 0.05, 10.0);
+                a.freckle_strength = f.number_in("strength", 0.0, 1.0);
+                f.finish();
+            }
+            auto tint = [](JsonReader t, glm::dvec3* colour, double* amount) {
+                *colour = to_glm(t.numbers<3>("tint"));
+                for (int c = 0; c < 3; ++c)
+                    if ((*colour)[c] < 0.0 || (*colour)[c] > 1.5) t.at("tint").fail("three factors in [0, 1.5]");
+                *amount = t.number_in("amount", 0.0, 1.0);
+                t.finish();
+            };
+            tint(r.object("beard"), &a.beard_tint, &a.beard_amount);
+            tint(r.object("forehead"), &a.forehead_tint, &a.forehead_amount);
+            tint(r.object("periorbital"), &a.periorbital_tint, &a.periorbital_amount);
+            a.lip_border_mm = r.number_in("lip_border_mm", 0.05, 5.0);
+            a.lip_lines = r.number_in("lip_lines", 0.0, 1.0);
+            a.lid_margin = colour(r, "lid_margin");
+            {
+                JsonReader g = r.object("roughness");
+                p.gloss.t_zone = g.number_in("t_zone", 0.3, 1.0);
+                p.gloss.lips = g.number_in("lips", 0.3, 1.0);
+                p.gloss.lid_margin = g.number_in("lid_margin", 0.3, 1.0);
+                p.gloss.tear_line = g.number_in("tear_line", 0.3, 1.0);
+                g.finish();
+            }
             r.finish();
         }
     });

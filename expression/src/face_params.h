@@ -14,11 +14,33 @@
 namespace emoface::expression::detail {
 
 // An ellipsoid pitched by tilt_deg about the x axis (positive: its front end
-// goes down), as the mandible runs from the chin up to the jaw angle.
+// goes down), as the mandible runs from the chin up to the jaw angle. With an
+// exponent above 2 it is a superellipsoid, |x/a|^e + |y/b|^e + |z/c|^e = 1:
+// flatter faces and fuller shoulders, as the cranium's top, sides and back.
 struct Ellipsoid {
     glm::dvec3 centre{0.0};
     glm::dvec3 radii{0.0};
     double tilt_deg = 0.0;
+    double exponent = 2.0;
+};
+
+// A rod from `from` to `to` whose radius goes from radii[0] to radii[1]
+// (a tapered capsule): the mandible's lower border from the jaw angle to
+// the chin. `mirror`: also its mirror image across x = 0.
+struct Capsule {
+    glm::dvec3 from{0.0}, to{0.0};
+    glm::dvec2 radii{0.0};
+    bool mirror = false;
+};
+
+// One volume of the head's smooth union (an ellipsoid, or a capsule when
+// `is_capsule`), joined to those before it with a fillet of size `blend` (mm).
+struct HeadPart {
+    std::string name;
+    bool is_capsule = false;
+    Ellipsoid shape;
+    Capsule capsule;
+    double blend = 0.0;
 };
 
 // A smooth bump added to the face's depth (z) over a frontal ellipse:
@@ -68,12 +90,16 @@ struct FaceParams {
     int eyeball_rings = 0, eyeball_segments = 0;
     int texture_size = 0;
 
-    // head volume (smooth union)
-    Ellipsoid skull, lower_face, jaw;
+    // head volume: the smooth union of the parts (cranium, cheekbones, face,
+    // jaw, ...), then the neck, an elliptic cylinder whose axis leans forward
+    // by neck_lean_deg (its top in front of its bottom), capped at neck_top_y
+    // inside the head, then the shoulders (the trapezius' slope is the fillet)
+    std::vector<HeadPart> head_parts;
     double neck_centre_z = 0.0;
     glm::dvec2 neck_radii{0.0};
-    double neck_top_y = 0.0, neck_blend = 0.0;
-    double blend = 0.0;
+    double neck_top_y = 0.0, neck_lean_deg = 0.0, neck_blend = 0.0;
+    Ellipsoid shoulders;
+    double shoulders_blend = 0.0;
 
     // eyes (left eye; the right one mirrors it)
     glm::dvec3 eye_centre{0.0};
@@ -118,9 +144,12 @@ struct FaceParams {
     std::vector<Ridge> ridges;
     std::vector<Bump> nostrils;  // dents painted dark
 
-    // ears (left; mirrored)
+    // ears (left; mirrored): centre and half length / half breadth on the
+    // side of the head (y, z), the long axis tilted back by ear_tilt_deg (its
+    // top behind its bottom), the helix rim's height off the scalp
     glm::dvec2 ear_centre_yz{0.0};
     glm::dvec2 ear_radii_yz{0.0};
+    double ear_tilt_deg = 0.0;
     double ear_height = 0.0;
 
     // pivots
@@ -143,6 +172,36 @@ struct FaceParams {
     double hairline_y = 0.0;
     glm::dvec2 hairline_temple{0.0};
     double sideburn_z = 0.0, sideburn_bottom_y = 0.0, hair_back_bottom_y = 0.0;
+    // hair: the whorl the strands flow from, the width of the hairline's
+    // fading band, the strands' size and the tips' lightening
+    glm::dvec3 hair_crown{0.0};
+    double hairline_band = 0.0, hair_strand_width = 0.0, hair_strand_length = 0.0, hair_tip_lightening = 0.0;
+    // brow hairs: spacing of their roots, length at the inner end and beyond,
+    // width (mm), angle off the brow line (degrees) of the medial ones and of
+    // the lateral ones above and below the line (which converge on it)
+    double brow_hair_spacing = 0.0, brow_hair_width = 0.0;
+    glm::dvec2 brow_hair_length{0.0};
+    double brow_medial_angle = 0.0, brow_lateral_angle = 0.0;
+
+    // albedo variation of the skin (face.json "albedo"; mm, fractions)
+    struct Flush {
+        glm::dvec2 centre{0.0}, size{0.0};  // |x|, y; Gaussian widths
+        double amount = 0.0;
+    };
+    struct Albedo {
+        double pigment_variation = 0.0, mottling = 0.0;
+        std::vector<Flush> flush;
+        double flush_breakup = 0.0, ear_flush = 0.0;
+        double freckle_spacing = 0.0, freckle_size = 0.0, freckle_strength = 0.0;
+        glm::dvec3 beard_tint{1.0}, forehead_tint{1.0}, periorbital_tint{1.0};
+        double beard_amount = 0.0, forehead_amount = 0.0, periorbital_amount = 0.0;
+        double lip_border_mm = 0.0, lip_lines = 0.0;
+        glm::dvec3 lid_margin{0.0};
+    } albedo;
+    // roughness scale per region (the base map's alpha; 1 = skin.json's)
+    struct Gloss {
+        double t_zone = 1.0, lips = 1.0, lid_margin = 1.0, tear_line = 1.0;
+    } gloss;
 };
 
 FaceParams read_face_params(const std::string& params_dir);

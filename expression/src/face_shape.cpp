@@ -1,6 +1,7 @@
 #include "face_shape.h"
 
 #include <algorithm>
+#include <initializer_list>
 #include <limits>
 
 namespace emoface::expression::detail {
@@ -9,13 +10,38 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 double ellipsoid_field(glm::dvec3 p, const Ellipsoid& e) {
-    const double t = e.tilt_deg * kPi / 180.0;
     const glm::dvec3 d{p.x - e.centre[0], p.y - e.centre[1], p.z - e.centre[2]};
-    const double ly = d.y * std::cos(t) + d.z * std::sin(t);
-    const double lz = -d.y * std::sin(t) + d.z * std::cos(t);
+    double ly = d.y, lz = d.z;
+    if (e.tilt_deg != 0.0) {
+        const double t = e.tilt_deg * kPi / 180.0, c = std::cos(t), s = std::sin(t);
+        ly = d.y * c + d.z * s;
+        lz = -d.y * s + d.z * c;
+    }
     const glm::dvec3 q{d.x / e.radii[0], ly / e.radii[1], lz / e.radii[2]};
     const double rmin = std::min({e.radii[0], e.radii[1], e.radii[2]});
-    return (glm::length(q) - 1.0) * rmin;
+    // The exponent-norm of q is at most its length for exponents above 2, so
+    // the field stays 1-Lipschitz (a lower bound of the distance): cast()
+    // relies on it.
+    const double len = e.exponent == 2.0
+                           ? glm::length(q)
+                           : std::pow(std::pow(std::abs(q.x), e.exponent) + std::pow(std::abs(q.y), e.exponent) +
+                                          std::pow(std::abs(q.z), e.exponent),
+                                      1.0 / e.exponent);
+    return (len - 1.0) * rmin;
+}
+
+double capsule_field(glm::dvec3 p, const Capsule& c, double sign) {
+    const glm::dvec3 a{c.from.x * sign, c.from.y, c.from.z}, b{c.to.x * sign, c.to.y, c.to.z};
+    const glm::dvec3 ab = b - a;
+    const double t = clamp01(glm::dot(p - a, ab) / std::max(glm::dot(ab, ab), 1e-12));
+    return glm::length(p - (a + ab * t)) - mix(c.radii[0], c.radii[1], t);
+}
+
+double part_field(glm::dvec3 p, const HeadPart& part) {
+    if (!part.is_capsule) return ellipsoid_field(p, part.shape);
+    double f = capsule_field(p, part.capsule, 1.0);
+    if (part.capsule.mirror) f = std::min(f, capsule_field(p, part.capsule, -1.0));
+    return f;
 }
 
 // Polynomial smooth minimum: the union of two volumes with a fillet of size k.
@@ -95,7 +121,8 @@ double EyeOpening::lower(double ax) const {
     return slit(ax) - lower_height * lid_profile(s(ax), lower_peak);
 }
 
-FaceShape::FaceShape(const FaceParams& params) : p_(params) {
+FaceShape::FaceShape(const FaceParams& params)
+    : p_(params), neck_lean_tan_(std::tan(params.neck_lean_deg * kPi / 180.0)) {
     eye.x_in = p_.inner_corner[0];
     eye.y_in = p_.inner_corner[1];
     eye.x_out = p_.outer_corner[0];
@@ -113,13 +140,17 @@ void FaceShape::set_eye_corners(double x_in, double x_out) {
 }
 
 double FaceShape::field(glm::dvec3 p) const {
-    double f = smooth_min(ellipsoid_field(p, p_.skull), ellipsoid_field(p, p_.lower_face), p_.blend);
-    f = smooth_min(f, ellipsoid_field(p, p_.jaw), p_.blend);
-    // The neck: a vertical elliptic cylinder, capped inside the head.
-    const double qx = p.x / p_.neck_radii[0], qz = (p.z - p_.neck_centre_z) / p_.neck_radii[1];
+    double f = part_field(p, p_.head_parts.front());
+    for (std::size_t i = 1; i < p_.head_parts.size(); ++i)
+        f = smooth_min(f, part_field(p, p_.head_parts[i]), p_.head_parts[i].blend);
+    // The neck: an elliptic cylinder leaning forward (its axis' z grows with
+    // y), capped inside the head.
+    const double axis_z = p_.neck_centre_z + (p.y - p_.neck_top_y) * neck_lean_tan_;
+    const double qx = p.x / p_.neck_radii[0], qz = (p.z - axis_z) / p_.neck_radii[1];
     const double cyl = (std::sqrt(qx * qx + qz * qz) - 1.0) * std::min(p_.neck_radii[0], p_.neck_radii[1]);
     const double neck = std::max(cyl, p.y - p_.neck_top_y);
-    return smooth_min(f, neck, p_.neck_blend);
+    f = smooth_min(f, neck, p_.neck_blend);
+    return smooth_min(f, ellipsoid_field(p, p_.shoulders), p_.shoulders_blend);
 }
 
 glm::dvec3 FaceShape::field_normal(glm::dvec3 p) const {
@@ -131,13 +162,18 @@ glm::dvec3 FaceShape::field_normal(glm::dvec3 p) const {
 }
 
 double FaceShape::cast(glm::dvec3 origin, glm::dvec3 dir) const {
-    constexpr double kStep = 1.5, kMax = 600.0;
-    double lo = 0.0, hi = kStep;
-    while (hi < kMax && field(origin + dir * hi) < 0.0) {
+    // Sphere tracing: the field is (nearly) 1-Lipschitz, so from a point
+    // inside at field value f the surface is at least |f| away; 0.8 of that
+    // leaves room for the neck's lean. Then bisection of the last step.
+    constexpr double kMinStep = 0.3, kMax = 600.0;
+    double lo = 0.0, hi = 0.0;
+    for (;;) {
+        const double f = field(origin + dir * hi);
+        if (f >= 0.0 || hi >= kMax) break;
         lo = hi;
-        hi += kStep;
+        hi += std::max(-0.8 * f, kMinStep);
     }
-    for (int i = 0; i < 40; ++i) {
+    for (int i = 0; i < 20; ++i) {
         const double mid = 0.5 * (lo + hi);
         (field(origin + dir * mid) < 0.0 ? lo : hi) = mid;
     }
@@ -229,19 +265,85 @@ double FaceShape::lid_blend(double x, double y, double* margin_distance) const {
     return 1.0 - glm::smoothstep(p_.lid_blend_inner, p_.lid_blend_outer, d);
 }
 
+namespace {
+
+// The ear's half breadth at a (-1 lobe .. 1 top) as a fraction of the
+// widest: the upper ear is broad, the lobe narrower.
+double ear_width(double a) { return 0.62 + 0.38 * glm::smoothstep(-1.0, 0.35, a); }
+
+// Distance from (a, s) to a polyline of ear coordinates, in ear units.
+double ear_curve_distance(double a, double s, std::initializer_list<glm::dvec2> pts) {
+    double best = 1e9;
+    const glm::dvec2 p{a, s};
+    const glm::dvec2* prev = nullptr;
+    for (const glm::dvec2& q : pts) {
+        if (prev) {
+            const glm::dvec2 e = q - *prev;
+            const double t = clamp01(glm::dot(p - *prev, e) / std::max(glm::dot(e, e), 1e-12));
+            best = std::min(best, glm::length(p - (*prev + e * t)));
+        }
+        prev = &q;
+    }
+    return best;
+}
+
+double gauss(double d, double w) { return std::exp(-(d / w) * (d / w)); }
+
+}  // namespace
+
+glm::dvec2 FaceShape::ear_point(double a, double s) const {
+    const double t = p_.ear_tilt_deg * kPi / 180.0;
+    const double u = a * p_.ear_radii_yz[0], v = s * p_.ear_radii_yz[1] * ear_width(a);
+    // u runs up the tilted axis (up and back), v across it (forward).
+    return {p_.ear_centre_yz[0] + u * std::cos(t) + v * std::sin(t),
+            p_.ear_centre_yz[1] - u * std::sin(t) + v * std::cos(t)};
+}
+
+// The auricle as a height field over the side of the head: the helix rim
+// round the top and back, the scapha inside it, the Y of the antihelix and
+// its crura, the concha bowl sunk nearly to the scalp, the tragus in front
+// of it, the antitragus and a fleshy lobe without a rim. The ear is attached
+// along its front edge and stands off the head towards its free back rim
+// (the ear's plane about 20-30 degrees off the scalp, FIDELITY.md "Ear").
 double FaceShape::ear_relief(double y, double z) const {
-    const double u = (y - p_.ear_centre_yz[0]) / p_.ear_radii_yz[0];
-    const double v = (z - p_.ear_centre_yz[1]) / p_.ear_radii_yz[1];
-    const double rho = std::sqrt(u * u + v * v);
+    const double t = p_.ear_tilt_deg * kPi / 180.0;
+    const double dy = y - p_.ear_centre_yz[0], dz = z - p_.ear_centre_yz[1];
+    const double L = p_.ear_radii_yz[0];
+    const double a = (dy * std::cos(t) - dz * std::sin(t)) / L;
+    if (a < -1.1 || a > 1.1) return 0.0;
+    const double W = p_.ear_radii_yz[1] * ear_width(std::clamp(a, -1.0, 1.0));
+    const double s = (dy * std::sin(t) + dz * std::cos(t)) / W;
+    const double rho = std::sqrt(a * a + s * s);
     if (rho >= 1.0) return 0.0;
     const double H = p_.ear_height;
-    // Attached along the front edge (v > 0), standing off the head behind.
-    const double flare = 0.3 + 0.7 * glm::smoothstep(0.7, -0.7, v);
-    const double outline = 1.0 - glm::smoothstep(0.8, 1.0, rho);
-    double h = H * flare * outline;
-    h += 0.2 * H * flare * std::exp(-std::pow((rho - 0.78) / 0.08, 2));  // helix rim
-    h -= 0.45 * H * flare * std::exp(-(std::pow((u + 0.15) / 0.34, 2) + std::pow((v - 0.05) / 0.3, 2)));  // concha
-    return std::max(h, 0.0);
+    const double mm = std::min(L, W);  // ear units to mm near the rim
+    const double rim_d = (1.0 - rho) * mm;  // mm in from the outline
+    // The shell: low where it joins the head, high at the free rim; the lobe
+    // hangs flatter.
+    const double lobe = glm::smoothstep(-0.45, -0.8, a);
+    double h = H * (0.22 + 0.78 * glm::smoothstep(0.85, -0.85, s)) * (1.0 - 0.45 * lobe);
+    // The helix: from the front top, round the top and down the back; not
+    // along the front below its root, nor on the lobe.
+    const double helix = (1.0 - glm::smoothstep(0.25, 0.7, s) * glm::smoothstep(0.45, 0.1, a)) * (1.0 - lobe);
+    h += helix * (0.16 * H * gauss(rim_d - 1.6, 1.3) - 0.16 * H * gauss(rim_d - 4.6, 1.6));
+    // Antihelix and its two crura, an inner ridge parallel to the rim.
+    const double anti = ear_curve_distance(a, s, {{-0.55, -0.3}, {-0.1, -0.48}, {0.32, -0.42}, {0.68, 0.05}});
+    const double crus = ear_curve_distance(a, s, {{0.32, -0.42}, {0.3, 0.35}});
+    h += 0.14 * H * gauss(std::min(anti, 1.1 * crus) * mm, 2.0);
+    // Concha: a deep bowl in front of the antihelix, behind the tragus.
+    const double cu = (a + 0.08) / 0.36, cv = (s - 0.2) / 0.42;
+    const double bowl = std::max(0.0, 1.0 - cu * cu - cv * cv);
+    h = mix(h, 0.12 * H, glm::smoothstep(0.0, 0.6, bowl));
+    // Triangular fossa between the crura: shallow.
+    const double fa = (a - 0.55) / 0.18, fs = (s - 0.05) / 0.22;
+    h -= 0.08 * H * std::max(0.0, 1.0 - fa * fa - fs * fs);
+    // Tragus over the concha's front, antitragus behind the notch below it.
+    h += 0.3 * H * gauss(std::hypot((a + 0.2) * L, (s - 0.78) * W), 3.5);
+    h += 0.1 * H * gauss(std::hypot((a + 0.52) * L, (s + 0.05) * W), 3.0);
+    // The outline: a steep edge at the free rim, a gentler one where the
+    // front joins the face.
+    const double edge = 1.0 - glm::smoothstep(s > 0.6 ? 0.7 : 0.9, 1.0, rho);
+    return std::max(h * edge, 0.0);
 }
 
 glm::dvec3 FaceShape::displace(glm::dvec3 base) const {

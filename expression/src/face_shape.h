@@ -77,6 +77,10 @@ public:
 
     // Outward displacement of the ear relief at a side point (y, z), left ear.
     double ear_relief(double y, double z) const;
+    // The side point (y, z) at ear coordinates a (along the ear's tilted
+    // long axis, -1 lobe .. 1 top) and s (across it, -1 the free back rim ..
+    // 1 the front edge where the ear joins the head).
+    glm::dvec2 ear_point(double a, double s) const;
 
     // Depth of the nostril dents at (x, y) as a fraction 0..1 (for painting).
     double nostril_amount(double x, double y) const;
@@ -85,6 +89,7 @@ private:
     double lip_relief(double x, double y) const;
 
     const FaceParams& p_;
+    double neck_lean_tan_ = 0;
     double mouth_half_width_ = 0;
 };
 

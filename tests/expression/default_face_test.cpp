@@ -164,7 +164,6 @@ TEST(DefaultFace, BaseColourPaintsLipsRedderThanSkinAndHairDarker) {
         const int x = std::min(255, static_cast<int>(t[0] * 256));
         const int y = std::min(255, static_cast<int>((1 - t[1]) * 256));
         const std::uint8_t* p = &f.base_colour.rgba[(static_cast<std::size_t>(y) * 256 + x) * 4];
-        EXPECT_EQ(p[3], 255);
         return std::array<int, 3>{p[0], p[1], p[2]};
     };
     auto texel = [&](int vertex) { return texel_at(f.mesh.texcoord2D(TriMesh::VertexHandle(vertex))); };
@@ -218,12 +217,12 @@ TEST_F(BadFaceParams, MessagesNameTheFileAndKey) {
          "expression: " + file + ": mouth.centre_y: expected a number, found \"low\""},
         {replaced("\"texture_size\": 2048", "\"texture_size\": 9"),
          "expression: " + file + ": resolution.texture_size: expected an integer in [16, 8192], found 9"},
-        {replaced("\"2.10\": [0, -104],", "\"2.10\": [0, -104], \"2.99\": [0, 0],"),
+        {replaced("\"2.10\": [0, -97],", "\"2.10\": [0, -97], \"2.99\": [0, 0],"),
          "expression: " + file + ": feature_points.\"2.99\": expected an MPEG-4 feature point id as the key, found \"2.99\""},
-        {replaced("\"2.10\": [0, -104],", "\"2.10\": [0, -104], \"3.1\": [0, 0],"),
+        {replaced("\"2.10\": [0, -97],", "\"2.10\": [0, -97], \"3.1\": [0, 0],"),
          "expression: " + file + ": feature_points.\"3.1\": expected a point the generator does not place, found one it "
                                 "places (remove it)"},
-        {replaced("\"2.10\": [0, -104],", ""), "expression: " + file + ": feature_points: expected a target for \"2.10\", found none"},
+        {replaced("\"2.10\": [0, -97],", ""), "expression: " + file + ": feature_points: expected a target for \"2.10\", found none"},
     };
     for (const Case& c : cases) {
         const std::string dir = write(c.text);
