@@ -26,7 +26,7 @@ FrameTitle frame_title(const std::string& where, const expression::FaceState& st
                        const expression::EmotionMix* given) {
     // What the frame is: the file's frame, or the mix asked for.
     std::string what = where;
-    if (given && state.mix_source == expression::MixSource::FromActionUnits)
+    if (given && given->sum() > 0 && state.mix_source == expression::MixSource::FromActionUnits)
         what = (what.empty() ? "" : what + "   ") + "mix " + mix_label(*given);
     auto after = [&](const std::string& text) { return what.empty() ? text : what + "   " + text; };
     if (state.mix_source == expression::MixSource::FromActionUnits)

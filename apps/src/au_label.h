@@ -24,7 +24,8 @@ std::string au_label(const expression::AuIntensities& aus);
 std::string mix_label(const expression::EmotionMix& mix);
 
 // A frame's description in two lines (inspect's title). `where`: the frame
-// ("tour.fap frame 12/49"), "" for a --mix; `given`: the --mix given, if any.
+// ("tour.fap frame 12/49"), "" for a --mix; `given`: the --mix given, if any
+// (named when it has emotions beside its AUs).
 // Where the emotion mix was derived from the AUs (a frame of low-level FAPs,
 // a --mix with AU terms), the AUs are what the face shows: they come first,
 // and the mix follows labelled as derived (it drives the wrinkles). Else the

@@ -29,7 +29,7 @@ using namespace emoface::apps;
 struct PlayArgs {
     std::string fap, out, size = "1280x720", frames;
     double fps = 0;
-    bool fps_given = false;
+    bool fps_given = false, frames_given = false;  // given, if only as 
     SessionArgs session;
     ViewerOptions viewer;  // without --out
 };
@@ -103,11 +103,11 @@ void run_viewer_for(const PlayArgs& a) {
     // The viewer plays the whole file at its own rate, scrubbed and paced by
     // its timeline: options that shape a written animation are refused
     // rather than silently ignored.
-    if (a.fps_given || !a.frames.empty())
+    if (a.fps_given || a.frames_given)
         fail<InputError>("play: {} shape{} the animation written with --out; the viewer plays the whole file at "
                          "its own rate (its timeline scrubs and sets the pace)",
-                         a.fps_given && !a.frames.empty() ? "--fps and --frames" : a.fps_given ? "--fps" : "--frames",
-                         a.fps_given && !a.frames.empty() ? "" : "s");
+                         a.fps_given && a.frames_given ? "--fps and --frames" : a.fps_given ? "--fps" : "--frames",
+                         a.fps_given && a.frames_given ? "" : "s");
     ViewerOptions v = a.viewer;
     v.command = "play";
     v.fap_path = a.fap;
@@ -138,6 +138,8 @@ void run_play(const PlayArgs& a) {
     const int count = a.fps_given
                           ? std::max(1, int(std::lround(double(stream.frames.size()) * fps / stream.fps)))
                           : int(stream.frames.size());
+    if (a.frames_given && a.frames.empty())
+        fail<InputError>("play: --frames '': expected A:B (first frame, end frame exclusive), e.g. 0:50, 50: or :50");
     const auto [first, end] = parse_slice(a.frames, count);
 
     std::unique_ptr<render::FrameSequenceWriter> sequence;
@@ -210,14 +212,15 @@ void add_play_command(CLI::App& root) {
     sub->add_option("--size", a->size, "Frame size WIDTHxHEIGHT")->capture_default_str();
     CLI::Option* fps = sub->add_option(
         "--fps", a->fps, "Output frame rate, 0.1..1000 (default: the file's); the animation is resampled");
-    sub->add_option("--frames", a->frames,
+    CLI::Option* frames = sub->add_option("--frames", a->frames,
                     "Render the slice A:B of the output frames, B exclusive (0:50 then 50:107 "
                     "together make 0:107); frame patterns are numbered by frame");
     add_session_options(*sub, a->session);
     add_side_by_side_option(*sub, a->session);
     add_viewer_options(*sub, a->viewer, out);
-    sub->callback([a, fps] {
+    sub->callback([a, fps, frames] {
         a->fps_given = fps->count() > 0;
+        a->frames_given = frames->count() > 0;
         run_play(*a);
     });
 }

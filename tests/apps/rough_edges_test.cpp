@@ -184,6 +184,57 @@ TEST(AuLabel, FormatsTheAusShownInInfoInspectAndTheViewer) {
     }
 }
 
+// inspect's title: where the emotion mix was derived from the AUs, the AUs
+// are the frame's description and the mix is labelled derived (issue 11: a
+// state of AU4 read as "mix 0.2 sadness + 0.1 anger").
+TEST(FrameTitle, NamesTheAusFirstWhereTheMixWasDerivedFromThem) {
+    using emoface::apps::frame_title;
+    using emoface::expression::Emotion;
+    using emoface::expression::EmotionMix;
+    using emoface::expression::FaceState;
+    using emoface::expression::MixSource;
+    FaceState derived;
+    derived.aus.left[4] = derived.aus.right[4] = 1.0;
+    derived.mix[Emotion::Sadness] = 0.2;
+    derived.mix[Emotion::Anger] = 0.1;
+    derived.mix_source = MixSource::FromActionUnits;
+    EmotionMix au4;
+    au4.aus.left[4] = au4.aus.right[4] = 1.0;
+    EmotionMix joy_au4 = au4;
+    joy_au4[Emotion::Joy] = 0.6;
+    FaceState given;
+    given.aus.left[4] = given.aus.right[4] = 0.5;
+    given.mix[Emotion::Sadness] = 1.0;
+    given.mix_source = MixSource::Given;
+    FaceState expression = given;
+    expression.mix_source = MixSource::Expression;
+    EmotionMix sadness;
+    sadness[Emotion::Sadness] = 1.0;
+
+    struct Case {
+        const char* what;
+        std::string where;
+        const FaceState& state;
+        const EmotionMix* given;
+        std::string first, second;
+    };
+    const std::string derived_line = "derived mix 0.20 sadness + 0.10 anger (from the AUs; it drives the wrinkles)";
+    const Case cases[] = {
+        {"--mix AU4", "", derived, &au4, "AUs 1 AU4", derived_line},
+        {"--mix 0.6 joy + AU4", "", derived, &joy_au4, "mix 0.60 joy + 1 AU4   AUs 1 AU4", derived_line},
+        {"a frame of low-level FAPs", "tour.fap frame 12/49", derived, nullptr, "tour.fap frame 12/49   AUs 1 AU4",
+         derived_line},
+        {"--mix sadness", "", given, &sadness, "mix 1.00 sadness", "AUs: 0.5 AU4"},
+        {"a frame of FAP 2", "tour.fap frame 3/49", expression, nullptr,
+         "tour.fap frame 3/49   mix 1.00 sadness [expression (FAP 2)]", "AUs: 0.5 AU4"},
+    };
+    for (const Case& c : cases) {
+        const auto title = frame_title(c.where, c.state, c.given);
+        EXPECT_EQ(title.first, c.first) << c.what;
+        EXPECT_EQ(title.second, c.second) << c.what;
+    }
+}
+
 // --- label placement ---------------------------------------------------------
 
 bool inside(const cv::Rect& box, cv::Size image) { return (box & cv::Rect(0, 0, image.width, image.height)) == box; }
