@@ -185,7 +185,7 @@ struct Renderer::Impl {
             wrinkle_map, use_wrinkle_map, wrinkle_signed, light_position, light_ambient,
             light_diffuse, light_specular, specular_color, shininess, camera_position, projective,
             box, skin_model, skin_surface, scatter_table, max_curvature, mm_per_unit,
-            normal_softening, cavity_direct, pore_map, pore_tiles, pore_strength, f0, roughness,
+            normal_softening, cavity_direct, pore_map, pore_tiles, pore_strength, albedo_bump, albedo_bump_bias, f0, roughness,
             lobe_weight, fill_direction, fill_colour, rim_direction, rim_colour, sky, ground,
             exposure, tone_map;
     } loc{};
@@ -272,6 +272,8 @@ Renderer::Renderer(Platform& platform) : impl_(std::make_unique<Impl>(platform))
     l.pore_map = u("u_pore_map");
     l.pore_tiles = u("u_pore_tiles");
     l.pore_strength = u("u_pore_strength");
+    l.albedo_bump = u("u_albedo_bump");
+    l.albedo_bump_bias = u("u_albedo_bump_bias");
     l.f0 = u("u_f0");
     l.roughness = u("u_roughness");
     l.lobe_weight = u("u_lobe_weight");
@@ -509,6 +511,8 @@ void Renderer::draw(const DrawOptions& o, const WrinkleTexture* wrinkle_map) {
         glUniform1f(im.loc.cavity_direct, k.cavity_direct);
         glUniform1f(im.loc.pore_tiles, k.pore_tiles);
         glUniform1f(im.loc.pore_strength, k.pore_strength);
+        glUniform1f(im.loc.albedo_bump, k.albedo_bump_mm / k.mm_per_unit);
+        glUniform1f(im.loc.albedo_bump_bias, k.albedo_bump_bias);
         glUniform1f(im.loc.f0, k.f0);
         glUniform2f(im.loc.roughness, k.roughness[0], k.roughness[1]);
         glUniform1f(im.loc.lobe_weight, k.lobe_weight);

@@ -97,6 +97,8 @@ uniform float u_cavity_direct;
 uniform sampler2D u_pore_map;       // rgb normal, a cavity
 uniform float u_pore_tiles;
 uniform float u_pore_strength;
+uniform float u_albedo_bump;        // detail height (scene units) per unit of log-luminance contrast
+uniform float u_albedo_bump_bias;   // mip levels up to the local mean the contrast is taken against
 uniform float u_f0;
 uniform vec2 u_roughness;
 uniform float u_lobe_weight;
@@ -213,13 +215,18 @@ vec3 shade_light(Surface s, vec3 l, vec3 c, const bool full) {
     return color * c;
 }
 
-vec3 shade_skin(vec3 n_bumped, vec3 n_geo, vec3 base, float cavity) {
+// `gloss`: the base map's alpha, the region's roughness scale (lips, the
+// tear line and the T-zone below 1; 1 where a map has no such regions).
+// `detail`: the base colour's log-luminance above its local mean, a height
+// in scene units (hair strands, brow hairs, lip lines stand out of the darker
+// gaps between them).
+vec3 shade_skin(vec3 n_bumped, vec3 n_geo, vec3 base, float cavity, float gloss, float detail) {
     Surface s;
     s.v = normalize(u_camera_position - v_position);
     s.cavity = cavity;
     vec2 roughness;
     if (u_skin_surface) {
-        roughness = u_roughness;
+        roughness = u_roughness * clamp(gloss, 0.3, 1.0);
         s.lobe_weight = u_lobe_weight;
         // Pores, in the frame of the base UVs built from screen derivatives
         // (Schueler 2006); their filtered normal's shortening (Toksvig)
@@ -240,6 +247,12 @@ vec3 shade_skin(vec3 n_bumped, vec3 n_geo, vec3 base, float cavity) {
             vec3 tilted = n_bumped * pn.z + u_pore_strength * scale * (t * pn.x + b * pn.y);
             if (dot(tilted, tilted) > 1e-12) s.n = normalize(tilted);
         }
+        // The albedo's detail as a bump (Mikkelsen 2010, surface gradient
+        // from screen derivatives of the height).
+        float det = dot(dp1, dp2perp);
+        vec3 gradient = sign(det) * (dFdx(detail) * dp2perp + dFdy(detail) * dp1perp);
+        vec3 detailed = abs(det) * s.n - gradient;
+        if (dot(detailed, detailed) > 1e-20) s.n = normalize(detailed);
         float variance = u_pore_strength * u_pore_strength * (1.0 - shortening) / shortening;
         roughness = sqrt(clamp(roughness * roughness + vec2(variance), 0.0, 1.0));
         s.cavity = cavity * pore.a;
@@ -307,10 +320,25 @@ void main() {
         if (dot(bumped, bumped) > 1e-12) n = normalize(bumped);
     }
     vec3 base = u_base_color;
-    if (u_has_base_map) base *= texture(u_base_map, v_base_uv).rgb;
+    float gloss = 1.0, detail = 0.0;
+    if (u_has_base_map) {
+        vec4 texel = texture(u_base_map, v_base_uv);
+        base *= texel.rgb;
+        if (u_skin_model) {
+            gloss = texel.a;
+            if (u_albedo_bump > 0.0) {
+                const vec3 luma = vec3(0.2126, 0.7152, 0.0722);
+                vec3 mean = texture(u_base_map, v_base_uv, u_albedo_bump_bias).rgb;
+                // Clamped: the step from skin to a dark hair is a colour edge,
+                // not a cliff.
+                detail = u_albedo_bump * clamp(log(dot(texel.rgb, luma) + 0.004) - log(dot(mean, luma) + 0.004),
+                                               -0.5, 0.5);
+            }
+        }
+    }
 
     if (u_skin_model) {
-        vec3 color = u_exposure * shade_skin(n, n_geo, base, cavity);
+        vec3 color = u_exposure * shade_skin(n, n_geo, base, cavity, gloss, detail);
         frag_color = vec4(srgb_encode(u_tone_map ? tone_map(color) : color), 1.0);
         return;
     }

@@ -76,6 +76,11 @@ SkinShading load_skin_shading(const std::string& path) {
         s.pore_strength = float(pores.number_in("strength", 0.0, 4.0));
         pores.finish();
 
+        JsonReader detail = root.object("albedo_detail");
+        s.albedo_bump_mm = float(detail.number_in("bump_mm", 0.0, 10.0));
+        s.albedo_bump_bias = float(detail.number_in("mip_bias", 0.5, 8.0));
+        detail.finish();
+
         JsonReader rig = root.object("light_rig");
         s.fill = rig_light(rig.object("fill"));
         s.rim = rig_light(rig.object("rim"));

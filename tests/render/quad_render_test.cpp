@@ -392,6 +392,9 @@ protected:
                           const SkinShading& skin) {
         Material m;
         m.base_color = albedo;
+        return draw(m, view_deg, light, skin);
+    }
+    static glm::vec3 draw(const Material& m, float view_deg, const Light& light, const SkinShading& skin) {
         renderer_->set_material(white_, m);
         DrawOptions d;
         d.camera.position = {0.0f, 0.0f, 50.0f};
@@ -528,6 +531,38 @@ TEST_F(SkinQuad, WrinkleAlphaIsACavity) {
         EXPECT_NEAR(open_skin.at(c, c)[ch], none.at(c, c)[ch], 1) << "channel " << ch;
         EXPECT_LT(creviced.at(c, c)[ch] + 5, open_skin.at(c, c)[ch]) << "channel " << ch;
     }
+}
+
+// The base map's alpha is the region's roughness scale (the default face's
+// painter: lips, T-zone, tear line below 1): a glossier region's lobe is
+// narrower, brighter towards the mirror direction and darker away from it.
+TEST_F(SkinQuad, BaseMapAlphaNarrowsTheSheen) {
+    SkinShading skin = dark_rig();
+    skin.albedo_bump_mm = 0.0f;
+    auto sheen = [&](std::uint8_t alpha, const glm::vec3& towards) {
+        Material m;
+        auto base = std::make_shared<ImageRGBA8>(4, 4);
+        for (int i = 0; i < 16; ++i) {
+            std::uint8_t* p = base->pixels.data() + 4 * i;
+            p[0] = p[1] = p[2] = 0;  // black: only the sheen comes back
+            p[3] = alpha;
+        }
+        m.base_texture = base;
+        Light light;
+        light.position = glm::vec4(glm::normalize(towards), 0.0f);
+        light.diffuse = glm::vec3(1.0f);
+        return draw(m, 0.0f, light, skin).g;
+    };
+    const glm::vec3 mirror{0.0f, 0.0f, 1.0f}, off{0.0f, std::sin(0.9f), std::cos(0.9f)};  // 52 degrees off
+    const float rough_peak = sheen(255, mirror), glossy_peak = sheen(90, mirror);
+    const float rough_off = sheen(255, off), glossy_off = sheen(90, off);
+    EXPECT_GT(glossy_peak, 1.5f * rough_peak) << "a narrower lobe is brighter at its peak";
+    EXPECT_LT(glossy_off, 0.8f * rough_off) << "and darker away from it";
+    // Alpha 255 is the data's roughness, the same as no base map.
+    Light head_on;
+    head_on.position = glm::vec4(mirror, 0.0f);
+    head_on.diffuse = glm::vec3(1.0f);
+    EXPECT_NEAR(rough_peak, draw(glm::vec3(0.0f), 0.0f, head_on, skin).g, 0.002f);
 }
 
 #ifdef EMOFACE_DATA_DIR

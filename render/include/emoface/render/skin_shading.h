@@ -17,6 +17,12 @@
 //   pores     a tiled, deterministic pore normal map generated at load
 //             (mipmapped; the length of its filtered normal widens the lobes,
 //             Toksvig, so pores too small to see still roughen the sheen);
+//   regions   the base map's alpha scales both roughnesses (the painter's
+//             regions: lips, the tear line, the T-zone glossier than the
+//             cheeks; 1, the skin.json values, where a map has no alpha);
+//   detail    the base colour's fine log-luminance contrast (above its mean a
+//             few mip levels up) as a height: hair strands, brow hairs and lip
+//             lines catch the light along their direction;
 //   light     the draw's key light, a fill and a rim light, a sky/ground
 //             hemisphere with specular occlusion (Lagarde & de Rousiers 2014)
 //             in the cavities; the sum is exposed, tone mapped (ACES fit,
@@ -102,6 +108,10 @@ struct SkinShading {
     float pore_tiles = 48.0f;    // pore tiles per unit of the base UVs
     float pore_strength = 0.6f;  // scale of the pore normals' tilt
 
+    // --- detail from the albedo ---
+    float albedo_bump_mm = 0.5f;   // height per unit of log-luminance contrast
+    float albedo_bump_bias = 2.0f;  // mip levels up to the mean it is taken against
+
     // --- light rig (the key light is the draw's Light) ---
     RigLight fill{{0.7f, 0.1f, 0.7f}, {0.16f, 0.17f, 0.19f}};
     RigLight rim{{0.5f, 0.6f, -0.65f}, {0.36f, 0.34f, 0.31f}};
@@ -115,7 +125,8 @@ struct SkinShading {
                mm_per_unit == o.mm_per_unit && normal_softening == o.normal_softening &&
                cavity_direct == o.cavity_direct && f0 == o.f0 && roughness == o.roughness &&
                lobe_weight == o.lobe_weight && pores == o.pores && pore_tiles == o.pore_tiles &&
-               pore_strength == o.pore_strength && fill == o.fill && rim == o.rim &&
+               pore_strength == o.pore_strength && albedo_bump_mm == o.albedo_bump_mm &&
+               albedo_bump_bias == o.albedo_bump_bias && fill == o.fill && rim == o.rim &&
                sky == o.sky && ground == o.ground && exposure == o.exposure &&
                tone_mapping == o.tone_mapping;
     }
