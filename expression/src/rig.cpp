@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <string_view>
 
@@ -12,6 +13,7 @@
 #include "emoface/fap/feature_points.h"
 #include "emoface/fap/fapu.h"
 #include "geodesic.h"
+#include "json_reader.h"
 
 namespace emoface::expression {
 namespace {
@@ -43,30 +45,32 @@ bool is_point_fap(int f) {
     return (f >= 4 && f <= 13) || (f >= 16 && f <= 22) || (f >= 31 && f <= 46) || (f >= 51 && f <= 68);
 }
 
-// Kernel radius of a feature point as a fraction of ES0 (eye separation):
-// about the distance to its neighbours on the same feature, so neighbouring
-// kernels overlap like a partition of unity; wider where skin moves in
-// broad sheets (brows, cheeks, chin).
+// Kernel radius of a feature point as a fraction of ES0 (eye separation).
+// The kernels are bells with no plateau, so they are wide: about twice the
+// distance to the neighbours on the same feature, and wider where skin moves
+// in broad sheets: a brow's reaches the hairline (the forehead rises as one
+// sheet), a cheek's the cheekbone and the jaw. The anchors' hold fades as
+// gently as the moving points' pull, or the skin creases against them.
 double radius_factor(std::string_view id) {
     static const std::map<std::string_view, double> table = {
-        {"2.2", 0.2},   {"2.3", 0.2},   {"2.4", 0.26},  {"2.5", 0.26},  {"2.6", 0.2},   {"2.7", 0.2},
-        {"2.8", 0.2},   {"2.9", 0.2},   {"2.10", 0.35}, {"2.11", 0.2},  {"2.12", 0.2},  {"2.13", 0.25},
-        {"2.14", 0.25}, {"3.1", 0.22},  {"3.2", 0.22},  {"3.3", 0.18},  {"3.4", 0.18},  {"3.7", 0.12},
-        {"3.8", 0.12},  {"3.11", 0.12}, {"3.12", 0.12}, {"4.1", 0.38},  {"4.2", 0.38},  {"4.3", 0.4},
-        {"4.4", 0.4},   {"4.5", 0.38},  {"4.6", 0.38},  {"5.1", 0.45},  {"5.2", 0.45},  {"5.3", 0.42},
-        {"5.4", 0.42},  {"6.1", 0.3},   {"6.2", 0.3},   {"6.3", 0.25},  {"6.4", 0.25},  {"8.1", 0.22},
-        {"8.2", 0.22},  {"8.3", 0.26},  {"8.4", 0.26},  {"8.5", 0.2},   {"8.6", 0.2},   {"8.7", 0.2},
-        {"8.8", 0.2},   {"8.9", 0.16},  {"8.10", 0.16}, {"9.1", 0.18},  {"9.2", 0.18},  {"9.3", 0.25},
-        {"10.1", 0.4},  {"10.2", 0.4},  {"10.3", 0.4},  {"10.4", 0.4},
+        {"2.2", 0.26},  {"2.3", 0.26},  {"2.4", 0.32},  {"2.5", 0.32},  {"2.6", 0.26},  {"2.7", 0.26},
+        {"2.8", 0.26},  {"2.9", 0.26},  {"2.10", 0.5},  {"2.11", 0.3},  {"2.12", 0.3},  {"2.13", 0.35},
+        {"2.14", 0.35}, {"3.1", 0.22},  {"3.2", 0.22},  {"3.3", 0.18},  {"3.4", 0.18},  {"3.7", 0.15},
+        {"3.8", 0.15},  {"3.11", 0.15}, {"3.12", 0.15}, {"4.1", 1.0},   {"4.2", 1.0},   {"4.3", 1.05},
+        {"4.4", 1.05},  {"4.5", 1.0},   {"4.6", 1.0},  {"5.1", 0.7},   {"5.2", 0.7},   {"5.3", 0.65},
+        {"5.4", 0.65},  {"6.1", 0.3},   {"6.2", 0.3},   {"6.3", 0.25},  {"6.4", 0.25},  {"8.1", 0.28},
+        {"8.2", 0.28},  {"8.3", 0.32},  {"8.4", 0.32},  {"8.5", 0.26},  {"8.6", 0.26},  {"8.7", 0.26},
+        {"8.8", 0.26},  {"8.9", 0.22},  {"8.10", 0.22}, {"9.1", 0.3},   {"9.2", 0.3},   {"9.3", 0.4},
+        {"10.1", 0.5},  {"10.2", 0.5},  {"10.3", 0.5},  {"10.4", 0.5},
     };
     auto it = table.find(id);
-    return it == table.end() ? 0.15 : it->second;
+    return it == table.end() ? 0.25 : it->second;
 }
 
 // Feature points no FAP moves that hold the skin around them in place.
 bool is_anchor(std::string_view id) {
     static const char* anchors[] = {"3.7",  "3.8",  "3.11", "3.12", "9.4",  "9.5",  "9.6",  "9.7",  "9.12",
-                                    "9.13", "9.14", "9.15", "11.1", "11.2", "11.3", "2.11", "2.12", "2.13",
+                                    "9.13", "9.14", "9.15", "2.11", "2.12", "2.13",
                                     "2.14", "10.5", "10.6", "10.7", "10.8", "10.9", "10.10"};
     for (const char* a : anchors)
         if (id == a) return true;
@@ -87,7 +91,60 @@ bool margin_y(const std::vector<std::array<double, 2>>& m, double x, double* y) 
     return false;
 }
 
+// The inner and outer lip contours are the two edges of one vermilion: a
+// frame that moves one contour and leaves its partner FAP at 0 (vreng's
+// files send only the outer FAPs 51-60) moves both, or the corners, where
+// the contours lie 2 mm apart, tear into a stitch.
+FapValues lip_contours_together(FapValues faps) {
+    for (int inner = 4; inner <= 13; ++inner) {
+        double& a = faps[inner - 1];
+        double& b = faps[inner + 47 - 1];  // 4 -> 51 ... 13 -> 60
+        if (a == 0.0) a = b;
+        else if (b == 0.0) b = a;
+    }
+    return faps;
+}
+
 }  // namespace
+
+FapRanges::FapRanges() {
+    lower.fill(-std::numeric_limits<double>::infinity());
+    upper.fill(std::numeric_limits<double>::infinity());
+}
+
+FapValues FapRanges::clamp(const FapValues& faps, int* clamped) const {
+    FapValues out;
+    for (int i = 0; i < fap::kFapCount; ++i) {
+        out[i] = std::clamp(faps[i], lower[i], upper[i]);
+        if (clamped && out[i] != faps[i]) ++*clamped;
+    }
+    return out;
+}
+
+FapRanges load_fap_ranges(const std::string& path) {
+    FapRanges r;
+    std::array<bool, fap::kFapCount> seen{};
+    detail::read_json_file(path, [&](detail::JsonReader& top) {
+        top.comment("_about");
+        for (auto& [name, entry] : top.object("faps").entries()) {
+            const auto f = fap::find_fap(name);
+            if (!f || *f < 3) entry.fail("a low-level FAP name (open_jaw ... pull_r_ear)", "\"" + name + "\"");
+            if (seen[*f - 1]) entry.fail("each FAP once", "\"" + name + "\" again");
+            seen[*f - 1] = true;
+            const auto range = entry.numbers<2>("range");
+            if (!(range[0] <= 0 && range[1] >= 0))
+                entry.at("range").fail("[min <= 0, max >= 0] (rest is in every range)");
+            entry.comment("why");
+            entry.finish();
+            r.lower[*f - 1] = range[0];
+            r.upper[*f - 1] = range[1];
+        }
+        for (int f = 3; f <= fap::kFapCount; ++f)
+            if (!seen[f - 1])
+                top.at("faps").fail("every low-level FAP", fmt::format("no \"{}\"", std::string(fap::fap_info(f).name)));
+    });
+    return r;
+}
 
 FaceRig::FaceRig(const Face& face, const RigOptions& options) {
     validate_face(face, "face \"" + face.name + "\"");
@@ -99,6 +156,7 @@ FaceRig::FaceRig(const Face& face, const RigOptions& options) {
     parts_ = face.parts;
     fps_ = face.feature_points;
     fapu_ = face.fapu;
+    ranges_ = options.ranges;
     if (!(fapu_.es > 0 && fapu_.mns > 0 && fapu_.mw > 0 && fapu_.ens > 0 && fapu_.irisd > 0))
         fail<InputError>("expression: rig: face \"{}\" has no FAPU (call update_fapu)", face.name);
 
@@ -211,43 +269,91 @@ void FaceRig::build_point_field(const Face& face, double radius_scale) {
     system_held_.clear();
     for (const Entry& e : entries) system_held_.push_back(e.held);
 
-    // Shepard interpolation with compact support. Weight W0 s / (1 - s) of
-    // s = falloff(g / R) for geodesic distance g: infinite at a feature point
-    // (which so moves exactly by its own displacement), 0 from R on; with the
-    // background weight W0 for "no motion", one point alone moves the skin
-    // around it by exactly s (a plateau, then a smooth fall to 0 at R, gentle
-    // enough that large FAPs do not fold the skin). Weights form a convex
-    // combination, so nothing overshoots.
-    constexpr double kBackground = 0.15;
-    auto falloff = [](double t) { return 1.0 - glm::smoothstep(0.2, 1.0, t); };
+    // A smooth partition of unity over geodesic distance, corrected to
+    // interpolate. Each entry j has a bell phi_j = wendland(g / R_j) (C2,
+    // flat at its centre, no plateau and no edge); a vertex's share of entry
+    // j is phi_j / (B + sum_k phi_k), where the background B stands for "no
+    // motion" and held entries (lid margins) and anchors count in the sum
+    // with no displacement of their own. So skin fades from moved to unmoved
+    // over the kernels' whole width, as a stretched sheet does, without the
+    // ridge a plateau-and-edge kernel leaves, and nothing overshoots a
+    // convex combination by much. The shares at the moving points form a
+    // small matrix S (S_ij = share of j at point i); the controls
+    // c = S^-1 d make every point move exactly by its own FAPs, and a
+    // vertex's weights on the displacements are its shares times S^-1,
+    // computed once here.
+    constexpr double kBackground = 0.5;
+    auto wendland = [](double t) { return t >= 1.0 ? 0.0 : std::pow(1.0 - t, 4) * (4.0 * t + 1.0); };
     detail::GeodesicGraph graph(face.mesh, face.welded);
-    std::vector<std::vector<std::pair<int, double>>> reach(n);  // (entry, distance)
+    std::vector<std::vector<std::pair<int, double>>> reach(n);  // (entry, share)
     for (std::size_t j = 0; j < entries.size(); ++j)
         for (auto [v, g] : graph.within(entries[j].sources, entries[j].radius))
-            reach[v].emplace_back(static_cast<int>(j), g);
+            reach[v].emplace_back(static_cast<int>(j), wendland(g / entries[j].radius));
+    for (auto& r : reach) {
+        double total = kBackground;
+        for (const auto& [j, phi] : r) total += phi;
+        for (auto& [j, phi] : r) phi /= total;
+    }
+    // The moving entries (driven by a FAP, not held), numbered 0..m-1.
+    std::vector<int> moving_of_entry(entries.size(), -1);
+    std::vector<int> moving;
+    for (std::size_t j = 0; j < entries.size(); ++j)
+        if (!entries[j].held && driven[system_fps_[j]]) {
+            moving_of_entry[j] = static_cast<int>(moving.size());
+            moving.push_back(static_cast<int>(j));
+        }
+    const int m = static_cast<int>(moving.size());
+    std::vector<double> inverse(static_cast<std::size_t>(m) * m, 0.0);  // S^-1, row-major
+    {
+        std::vector<double> s(static_cast<std::size_t>(m) * m, 0.0);
+        for (int i = 0; i < m; ++i) {
+            inverse[i * m + i] = 1.0;
+            for (const auto& [j, share] : reach[entries[moving[i]].sources[0]])
+                if (moving_of_entry[j] >= 0) s[i * m + moving_of_entry[j]] = share;
+        }
+        // Gauss-Jordan with partial pivoting (m is a few dozen).
+        for (int c = 0; c < m; ++c) {
+            int pivot = c;
+            for (int r = c + 1; r < m; ++r)
+                if (std::abs(s[r * m + c]) > std::abs(s[pivot * m + c])) pivot = r;
+            if (std::abs(s[pivot * m + c]) < 1e-9)
+                fail("expression: rig: the influence of feature point {} is not independent of its neighbours'",
+                     std::string(fap::feature_points()[system_fps_[moving[c]]].id));
+            for (int k = 0; k < m; ++k) {
+                std::swap(s[c * m + k], s[pivot * m + k]);
+                std::swap(inverse[c * m + k], inverse[pivot * m + k]);
+            }
+            const double inv = 1.0 / s[c * m + c];
+            for (int k = 0; k < m; ++k) s[c * m + k] *= inv, inverse[c * m + k] *= inv;
+            for (int r = 0; r < m; ++r) {
+                if (r == c || s[r * m + c] == 0.0) continue;
+                const double f = s[r * m + c];
+                for (int k = 0; k < m; ++k) s[r * m + k] -= f * s[c * m + k], inverse[r * m + k] -= f * inverse[c * m + k];
+            }
+        }
+    }
+    std::vector<int> moving_at_vertex(n, -1);
+    for (int i = 0; i < m; ++i) moving_at_vertex[entries[moving[i]].sources[0]] = i;
     influence_start_.assign(n + 1, 0);
+    std::vector<double> row(m);
     for (int v = 0; v < n; ++v) {
         influence_start_[v] = static_cast<int>(weights_.size());
-        if (reach[v].empty()) continue;
-        int at = -1;
-        double total = kBackground;
-        std::vector<double> w(reach[v].size());
-        for (std::size_t q = 0; q < reach[v].size(); ++q) {
-            const auto [j, g] = reach[v][q];
-            if (g <= 1e-9) at = j;
-            const double sv = falloff(g / entries[j].radius);
-            w[q] = g > 1e-9 && sv < 1.0 ? kBackground * sv / (1.0 - sv) : (g > 1e-9 ? 1e12 : 0.0);
-            total += w[q];
-        }
-        if (at >= 0) {
-            if (!entries[at].held) weights_.push_back({static_cast<std::uint16_t>(at), 1.0f});
+        if (moving_at_vertex[v] >= 0) {
+            // Exactly its own FAPs (the product below is, up to rounding).
+            weights_.push_back({static_cast<std::uint16_t>(moving[moving_at_vertex[v]]), 1.0f});
             continue;
         }
-        for (std::size_t q = 0; q < reach[v].size(); ++q) {
-            const int j = reach[v][q].first;
-            const double wq = w[q] / total;
-            if (!entries[j].held && wq > 1e-5) weights_.push_back({static_cast<std::uint16_t>(j), static_cast<float>(wq)});
+        bool any = false;
+        std::fill(row.begin(), row.end(), 0.0);
+        for (const auto& [j, share] : reach[v]) {
+            const int i = moving_of_entry[j];
+            if (i < 0 || share < 1e-7) continue;
+            any = true;
+            for (int k = 0; k < m; ++k) row[k] += share * inverse[i * m + k];
         }
+        if (!any) continue;
+        for (int k = 0; k < m; ++k)
+            if (std::abs(row[k]) > 1e-4) weights_.push_back({static_cast<std::uint16_t>(moving[k]), static_cast<float>(row[k])});
     }
     influence_start_[n] = static_cast<int>(weights_.size());
 
@@ -282,6 +388,26 @@ void FaceRig::build_point_field(const Face& face, double radius_scale) {
             if (h < -1e-3) continue;
             const double w = std::min(opening(x) / o_fp, 1.0) * raised_cosine(std::max(h, 0.0) / fade);
             if (w > 1e-5) lid_weights_.push_back({v, lid, static_cast<float>(v == src ? 1.0 : w)});
+        }
+        if (!upper) continue;
+        // The upper lid's inner part follows the inner brow (FACS: AU1
+        // draws the inner upper lid up with the brow, AU4 pushes it down and
+        // in): the oblique lid of the sad eye. The share peaks a third of
+        // the way from the inner corner and is nothing at both corners.
+        const int brow = fap::feature_point_index(side == 0 ? "4.1" : "4.2");
+        if (!fps_[brow].present) continue;
+        constexpr double kBrowFollow = 0.35;
+        const double x_inner = margin.front()[0], x_outer = margin.back()[0];
+        const int follow = static_cast<int>(lid_fps_.size());
+        lid_fps_.push_back(brow);
+        for (auto [v, g] : graph.within({src}, 0.35 * es0 * radius_scale)) {
+            if (parts_[v] != VertexPart::Skin) continue;
+            const double x = neutral_[v][0], y = neutral_[v][1];
+            double ym;
+            if (!margin_y(margin, x, &ym) || y - ym < -1e-3) continue;
+            const double t = std::clamp((x - x_inner) / (x_outer - x_inner), 0.0, 1.0);
+            const double w = kBrowFollow * 6.75 * t * (1 - t) * (1 - t) * raised_cosine(std::max(y - ym, 0.0) / fade);
+            if (w > 1e-5) lid_weights_.push_back({v, follow, static_cast<float>(w)});
         }
     }
 }
@@ -404,7 +530,11 @@ void FaceRig::build_eyes(const Face& face) {
     if (clearance > 1e29) return;
     clearance = std::max(clearance, 0.0);
     std::vector<float> follow(neutral_.size(), 0.0f);
-    for (const LidWeight& lw : lid_weights_) follow[lw.vertex] = std::max(follow[lw.vertex], lw.weight);
+    // (Only the lid FAPs turn skin about the eye; the inner brow's share
+    // of the upper lid moves it as the brow moves the skin above.)
+    for (const LidWeight& lw : lid_weights_)
+        if (fap::feature_points()[lid_fps_[lw.lid]].id[0] == '3')
+            follow[lw.vertex] = std::max(follow[lw.vertex], lw.weight);
     for (int v = 0; v < static_cast<int>(neutral_.size()); ++v) {
         if (parts_[v] != VertexPart::Skin) continue;
         for (std::size_t e = 0; e < eyes_.size(); ++e) {
@@ -449,9 +579,25 @@ void FaceRig::point_displacements(const FapValues& faps, std::array<std::array<d
         const double s = value * fapu_.of(info.unit);
         for (int c = 0; c < 3; ++c) d[*fp][c] += s * info.direction[c];
     }
+    // A mouth corner's inner and outer points (2.4 and 8.3) are one corner
+    // a lip's thickness apart: they may move apart by at most half that
+    // distance, or the skin between them shears into a stitch. Both give
+    // way towards their mean.
+    for (const auto& [inner_id, outer_id] : {std::pair{"2.4", "8.3"}, std::pair{"2.5", "8.4"}}) {
+        const int i = fap::feature_point_index(inner_id), o = fap::feature_point_index(outer_id);
+        if (!fps_[i].present || !fps_[o].present) continue;
+        const V diff = to_v(d[o]) - to_v(d[i]);
+        const double apart = glm::length(diff);
+        const double allowed = 0.5 * glm::length(to_v(fps_[o].position) - to_v(fps_[i].position));
+        if (apart <= allowed) continue;
+        const V give = diff * (0.5 * (apart - allowed) / apart);
+        d[i] = to_array(to_v(d[i]) + give);
+        d[o] = to_array(to_v(d[o]) - give);
+    }
 }
 
-void FaceRig::deform(const FapValues& faps, DeformedFace& out) const {
+void FaceRig::deform(const FapValues& given, DeformedFace& out) const {
+    const FapValues faps = lip_contours_together(ranges_.clamp(given));
     const int n = static_cast<int>(neutral_.size());
     out.positions.assign(neutral_.begin(), neutral_.end());
     auto& pos = out.positions;

