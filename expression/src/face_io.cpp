@@ -347,7 +347,12 @@ void save_fdp(const Face& face, const std::string& path, const std::string& mesh
 }
 
 Face load_obj_with_fdp(const std::string& obj_path, const std::string& fdp_path) {
-    const std::string text = read_text(obj_path);
+    const std::string obj_text = read_text(obj_path);
+    return parse_obj_with_fdp(obj_text, obj_path, detail::read_text_file(fdp_path), fdp_path);
+}
+
+Face parse_obj_with_fdp(std::string_view text, const std::string& obj_path, std::string_view fdp_text,
+                        const std::string& fdp_path) {
     std::vector<Vec3d> positions;
     std::vector<std::array<double, 2>> uvs;
     struct Corner {
@@ -458,7 +463,7 @@ Face load_obj_with_fdp(const std::string& obj_path, const std::string& fdp_path)
     // Pivots and texture box given in the file replace the estimated ones.
     std::optional<Vec3d> jaw_pivot, head_pivot;
     std::optional<TextureBox> texture_box;
-    detail::read_json_file(fdp_path, [&](detail::JsonReader& root) {
+    detail::read_json_text(fdp_text, fdp_path, [&](detail::JsonReader& root) {
         // Written by save_fdp; free text for people.
         root.comment("frame");
         if (root.has("format") && root.string("format") != "emoface-fdp")

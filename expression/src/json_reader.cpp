@@ -99,7 +99,7 @@ private:
     void open(bool array) {
         value();
         if (static_cast<int>(frames_.size()) >= kMaxDepth)
-            fail_data(kModule, FileLoc{file_, 0, path()}, fmt::format("at most {} levels of nesting", kMaxDepth),
+            fail_data(kModule, FileLoc{file_, 0, ""}, fmt::format("at most {} levels of nesting", kMaxDepth),
                       "more");
         frames_.push_back({array, 0, {}});
     }

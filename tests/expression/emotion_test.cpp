@@ -83,11 +83,38 @@ TEST(EmotionMix, RejectsWithMessagesThatNameThePart) {
         {"0.3 0.4 fear", "expression: emotion mix \"0.3 0.4 fear\": part 1 (\"0.3 0.4 fear\"): expected "
                          "\"name=weight\", \"weight name\" or \"name\""},
         {"anger=nan", "expression: emotion mix \"anger=nan\": part 1 (\"anger=nan\"): \"nan\" is not a number"},
+        // Not a number in float either: NaN and infinity spelt several ways.
+        {"anger=inf", "expression: emotion mix \"anger=inf\": part 1 (\"anger=inf\"): \"inf\" is not a number"},
+        {"anger=-Infinity", "expression: emotion mix \"anger=-Infinity\": part 1 (\"anger=-Infinity\"): "
+                            "\"-Infinity\" is not a number"},
+        {"1e999 joy", "expression: emotion mix \"1e999 joy\": part 1 (\"1e999 joy\"): \"1e999\" is not a number"},
+        // The user's text comes back escaped and cut: one short line.
+        {"joy\n+ fear\x1b[31m",
+         "expression: emotion mix \"joy\\n+ fear\\x1b[31m\": unknown emotion \"fear\\x1b[31m\" in part 2 "
+         "(\"fear\\x1b[31m\"); " + expected_names},
     };
     for (const Case& c : cases) {
         SCOPED_TRACE(c.text);
         testing::expect_error<InputError>([&] { parse_emotion_mix(c.text); }, c.message);
     }
+}
+
+TEST(EmotionMix, EchoesHugeNamesCut) {
+    // A 120 KB unknown name is echoed as its first 60 (the mix) or 40 (a
+    // part, a name) characters: the message stays one short line.
+    const std::string expected_names =
+        "expected joy (or happiness), sadness, anger, fear, disgust, surprise, neutral or an action unit (AU4, AU12L)";
+    const std::string huge(120000, 'x');
+    const std::string cut60 = std::string(60, 'x') + "\u2026", cut40 = std::string(40, 'x') + "\u2026";
+    testing::expect_error<InputError>([&] { parse_emotion_mix(huge); },
+                                      "expression: emotion mix \"" + cut60 + "\": unknown emotion \"" + cut40 +
+                                          "\" in part 1 (\"" + cut40 + "\"); " + expected_names);
+    const std::string au38 = "AU" + std::string(38, 'x') + "\u2026";
+    testing::expect_error<InputError>([&] { parse_emotion_mix("AU" + huge); },
+                                      "expression: emotion mix \"AU" + std::string(58, 'x') + "\u2026\": part 1 (\"" +
+                                          au38 + "\"): \"" + au38 +
+                                          "\" is not an action unit; expected AU<number>, AU<number>L or "
+                                          "AU<number>R (e.g. AU12, AU12L)");
 }
 
 TEST(EmotionMix, AcceptsActionUnitsBesideEmotions) {

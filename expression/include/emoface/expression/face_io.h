@@ -36,6 +36,10 @@ void save_fdp(const Face& face, const std::string& path, const std::string& mesh
 // and its FDP JSON. FAPU are computed from the feature points; pivots and
 // texture box are estimated when the FDP omits them.
 Face load_obj_with_fdp(const std::string& obj_path, const std::string& fdp_path);
+// The same from the two files' text; the names are for messages (and the
+// FDP's folder for its base-colour file).
+Face parse_obj_with_fdp(std::string_view obj_text, const std::string& obj_path, std::string_view fdp_text,
+                        const std::string& fdp_path);
 
 // --- Candide-3 --------------------------------------------------------------
 
