@@ -396,7 +396,7 @@ void FaceRig::build_point_field(const Face& face, double radius_scale) {
         // the way from the inner corner and is nothing at both corners.
         const int brow = fap::feature_point_index(side == 0 ? "4.1" : "4.2");
         if (!fps_[brow].present) continue;
-        constexpr double kBrowFollow = 0.35;
+        constexpr double kBrowFollow = 0.2;
         const double x_inner = margin.front()[0], x_outer = margin.back()[0];
         const int follow = static_cast<int>(lid_fps_.size());
         lid_fps_.push_back(brow);

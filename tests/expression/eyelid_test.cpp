@@ -150,13 +150,13 @@ TEST(Eyelids, TheUpperLidsInnerPartFollowsTheInnerBrow) {
         const double tilt = inner_lid_tilt(c.faps);
         std::printf("%-28s inner brow %+.2f IRISD, inner lid minus outer lid %+.2f IRISD\n", c.what, brow_rise, tilt);
         // The inner part moves with the brow, by a visible share of it
-        // (a tenth of an IRISD is 1 mm).
+        // (0.05 IRISD is half a millimetre).
         EXPECT_GT(tilt * brow_rise, 0.0);
-        EXPECT_GT(std::abs(tilt), 0.1);
+        EXPECT_GT(std::abs(tilt), 0.05);
         EXPECT_LT(std::abs(tilt), 0.5 * std::abs(brow_rise));
     }
     // The lid FAPs alone keep the margin's shape (no tilt from the brow field).
-    EXPECT_LT(std::abs(inner_lid_tilt(au_faps(5))), 0.1);
+    EXPECT_LT(std::abs(inner_lid_tilt(au_faps(5))), 0.05);
 }
 
 }  // namespace
