@@ -392,4 +392,28 @@ TEST_F(ViewUnderXvfb, MixWithoutOutShowsThePaintedWrinkleMaps) {
     }
 }
 
+// `mix` with AU terms and no --out opens the viewer with the AUs on top of
+// the emotions (issue 11; they were dropped, leaving joy alone): AU4 lowers
+// and draws the brows together, so the face differs from plain joy's.
+TEST_F(ViewUnderXvfb, MixWithoutOutShowsItsActionUnits) {
+    auto show = [&](const std::string& mix, const std::string& shot) {
+        return run_emoface({"mix", mix, "--size", "1200x1000", "--face-resolution", "0.5", "--texture-size", "256",
+                            "--wrinkle-size", "256", "--samples", "1", "--backend", "cpu", "--quit-after", "4",
+                            "--screenshot", shot},
+                           on_display(xvfb_->name()));
+    };
+    CommandResult r = show("0.6 joy + 1 AU4", path("au.png"));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    r = show("0.6 joy", path("joy.png"));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const ImageRGBA8 with_au = emoface::render::read_image_rgba8(path("au.png"));
+    const ImageRGBA8 joy = emoface::render::read_image_rgba8(path("joy.png"));
+    // The face's upper half, right of the panel (whose AU line differs too).
+    EXPECT_GT(fraction_differing(with_au, joy, 480, 200, 1100, 560), 0.01) << "the brows moved";
+    if (::testing::Test::HasFailure() || std::getenv("EMOFACE_KEEP_VIEWER_SHOTS")) {
+        fs::copy_file(path("au.png"), "viewer_test_au4.png", fs::copy_options::overwrite_existing);
+        fs::copy_file(path("joy.png"), "viewer_test_joy.png", fs::copy_options::overwrite_existing);
+    }
+}
+
 }  // namespace
