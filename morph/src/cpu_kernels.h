@@ -145,15 +145,18 @@ EMOFACE_INLINE void batch_points(const CpuJob& job, const Accum<K, PX>& acc, con
         float dx[K], dy[K];
         kernel::displacement(acc, j, plan.extent, dx, dy);
         const float px = static_cast<float>(x0 + j) + 0.5f, py = static_cast<float>(y) + 0.5f;
+        // (k runs to the compile-time K, so dx and dy stay in registers)
         if (job.positions != nullptr) {
             float* p = job.positions + (static_cast<std::size_t>(y) * job.width + x0 + j) * (2 * plan.sources);
-            for (int k = 0; k < batch.n; ++k) {
+            for (int k = 0; k < K; ++k) {
+                if (k >= batch.n) break;
                 p[2 * batch.slot[k]] = px + dx[k];
                 p[2 * batch.slot[k] + 1] = py + dy[k];
             }
             continue;
         }
-        for (int k = 0; k < batch.n; ++k) {
+        for (int k = 0; k < K; ++k) {
+            if (k >= batch.n) break;
             const int i = batch.slot[k];
             add_sample(col.c[j], job.keys[i], plan.weight[i], px + dx[k], py + dy[k]);
         }

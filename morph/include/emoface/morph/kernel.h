@@ -262,22 +262,10 @@ EMOFACE_HD EMOFACE_INLINE void accumulate_line(const float* rec, float x0, float
         EMOFACE_PIXEL_LOOP
         for (int j = 0; j < PX; ++j) w[j] = line_weight<L>(w[j], b);
     }
-    if (batch.n == K) {  // a full batch: no test per source
-        EMOFACE_PIXEL_LOOP
-        for (int j = 0; j < PX; ++j) {
-            acc.w[j] += w[j];
-            EMOFACE_UNROLL
-            for (int k = 0; k < K; ++k) {
-                const float* c = src + kSourceFloats * batch.slot[k];
-                acc.dx[k][j] += w[j] * (c[0] + s[j] * c[2] + v[j] * c[4]);
-                acc.dy[k][j] += w[j] * (c[1] + s[j] * c[3] + v[j] * c[5]);
-            }
-        }
-        return;
-    }
     EMOFACE_PIXEL_LOOP
     for (int j = 0; j < PX; ++j) acc.w[j] += w[j];
-    // (k < n is uniform over the points: a block's batch)
+    // (k < n is uniform over the points: a block's batch; a source's
+    // coefficients are read once for all points)
     EMOFACE_UNROLL
     for (int k = 0; k < K; ++k) {
         if (k >= batch.n) break;
