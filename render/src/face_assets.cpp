@@ -57,7 +57,7 @@ std::unique_ptr<FaceAssets> load_face_assets(expression::Face face, const std::s
     const std::string dir = data_dir + "/expression/";
     // Every data file is looked for first, so a wrong folder fails before the
     // slow part with the fix, not with the first reader's "cannot open".
-    for (const char* file : {"emotions.json", "visemes.json", "feature_lines.json", "wrinkles.json"})
+    for (const char* file : {"emotions.json", "visemes.json", "feature_lines.json", "wrinkles.json", "fap_ranges.json"})
         if (!std::filesystem::is_regular_file(dir + file))
             fail<InputError>("render: data folder {}: expression/{} is missing (expected the project's data/)",
                              data_dir, file);
@@ -66,7 +66,9 @@ std::unique_ptr<FaceAssets> load_face_assets(expression::Face face, const std::s
     a->layout = options.layout;
 
     auto t = Clock::now();
-    a->rig = std::make_unique<expression::FaceRig>(a->face);
+    expression::RigOptions rig_options;
+    rig_options.ranges = expression::load_fap_ranges(dir + "fap_ranges.json");
+    a->rig = std::make_unique<expression::FaceRig>(a->face, rig_options);
     a->times.rig_ms = ms_since(t);
 
     t = Clock::now();
