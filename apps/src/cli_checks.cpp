@@ -40,12 +40,6 @@ std::pair<std::string, std::string> split_output_path(const std::string& path, c
     return {p.parent_path().string(), name};
 }
 
-void check_output_folder(const std::string& path, const std::string& command, const std::string& option) {
-    const auto folder = split_output_path(path, command, option).first;
-    OutputBatch probe(folder, fmt::format("{}: {} {}", command, option, path));
-    probe.commit();  // nothing staged: keeps the folders it made
-}
-
 OutputFile::OutputFile(const std::string& path, const std::string& command, const std::string& option)
     : destination_(path),
       batch_(split_output_path(path, command, option).first, fmt::format("{}: {} {}", command, option, path)),

@@ -53,13 +53,6 @@ private:
     std::string staged_;
 };
 
-// Makes `path`'s folder (and its parents) when it is missing; InputError
-// when it cannot be made. Kept for `morph`, which has not moved to
-// OutputFile yet: unlike OutputFile, a folder it made stays when the command
-// fails afterwards.
-void check_output_folder(const std::string& path, const std::string& command,
-                         const std::string& option = "--out");
-
 // The folder of `path` ("" for a bare file name) and its file name; throws
 // "COMMAND: OPTION PATH: expected a file name, found ..." for "", a path
 // ending in '/' or naming "." or "..".

@@ -28,6 +28,7 @@
 #include "emoface/expression/emotion.h"
 #include "emoface/morph/morph.h"
 #include "emoface/render/face_assets.h"
+#include "emoface/render/image_io.h"
 #include "session.h"
 #include "sheet.h"
 
@@ -98,7 +99,9 @@ void run_morph(const MorphArgs& a) {
     if (a.tile < 64 || a.tile > 1024) fail<InputError>("morph: --tile {}: expected 64..1024", a.tile);
     const SessionOptions so = a.session.resolve("morph", a.tile, a.tile);
     if (a.out.empty()) fail<InputError>("morph: --out sheet.png is required");
-    check_output_folder(a.out, "morph");
+    split_output_path(a.out, "morph", "--out");
+    render::check_image_output(a.out, "morph: --out " + a.out);
+    OutputFile output(a.out, "morph");
     Session session(so);
     const int size = session.scene().wrinkle_texture().width();
     const render::WrinkleKey key_from = render::make_emotion_key(session.assets(), key_emotion(from), size);
@@ -174,7 +177,8 @@ void run_morph(const MorphArgs& a) {
     const std::string title = fmt::format("{} -> {}: wrinkle maps {}x{}, {} feature lines (thesis fig. 6.4)",
                                           a.from, a.to, size, size, session.lines().size());
     const cv::Mat sheet = contact_sheet(title, {bn, dissolve, bn_face, dissolve_face});
-    write_bgr(a.out, sheet);
+    write_bgr(output.path(), sheet);
+    output.commit();
 
     const auto [kmin, kmax] = std::minmax_element(kernel_ms.begin(), kernel_ms.end());
     double bump = 0;
