@@ -166,7 +166,8 @@ private:
     std::vector<glm::dvec3> base_;  // base (pre-relief) points of the skin vertices
     // vertex ranges of the mouth interior pieces
     int tongue_first_ = 0, tongue_count_ = 0, tongue_rings_ = 0, tongue_segments_ = 0;
-    int upper_teeth_first_ = 0, lower_teeth_first_ = 0, teeth_sections_ = 0;
+    // the teeth's feature points (9.8-9.11)
+    int upper_gum_point_ = 0, lower_gum_point_ = 0, upper_edge_point_ = 0, lower_edge_point_ = 0;
 };
 
 void Generator::make_columns() {
@@ -570,7 +571,9 @@ void Generator::build_mouth_interior(Face& face) {
         const int rings = 10, segs = 36;
         auto part_of = [&](double y) { return y >= cc.y ? VertexPart::MouthUpper : VertexPart::MouthLower; };
         auto uv = [&](double g, double s, double& u, double& v) {
-            const double rr = 0.48 * g / (0.5 * kPi);
+            // Most of the cavity maps near the tile's dark centre: the mouth's
+            // inside is dark but where the lips' light reaches in.
+            const double rr = 0.48 * std::pow(g / (0.5 * kPi), 3.0);
             u = detail::tile_u0(Tile::Cavity) + detail::kTile * (0.5 + rr * std::cos(s));
             v = detail::kTile * (0.5 + rr * std::sin(s));
         };
@@ -600,57 +603,182 @@ void Generator::build_mouth_interior(Face& face) {
                 add_oriented(face, ring(k, s), ring(k + 1, s + 1), ring(k, s + 1), inward(ring(k, s + 1)));
             }
     }
-    // Teeth: two arches swept along a curve behind the lips, a closed
-    // four-sided cross-section each.
+    // Teeth: individual crowns along each dental arch (incisors, canines,
+    // premolars, first molars; FaceParams crowns: width along the arch and
+    // crown height, from the midline out), each a loft of rounded sections
+    // from the gum line to the biting edge (incisors thin to a blade,
+    // canines to a point), and a gum band over their necks with papillae
+    // reaching down between them.
     const auto stomion = face.mesh.point(TriMesh::VertexHandle(grid(centre_col_, mouth_row_)));
-    const double z_upper = stomion[2] - p_.teeth_gap;
-    const double thickness = 2.4;
-    const int sections = 28;
-    teeth_sections_ = sections + 1;
+    const double z_front = stomion[2] - p_.teeth_gap;  // labial face of the upper incisors
     auto arch = [&](bool upper) {
-        const double y_edge = upper ? p_.mouth_y - 1.0 : p_.mouth_y + 1.2;
-        const double y_root = upper ? y_edge + p_.teeth_height : y_edge - p_.teeth_height * 0.9;
-        const double z0 = upper ? z_upper : z_upper - thickness - 0.4;
-        const double W = upper ? p_.teeth_half_width : p_.teeth_half_width - 1.5;
+        const double sign = upper ? 1.0 : -1.0;  // from the biting edge towards the root
+        const double y_edge = upper ? p_.mouth_y - 1.0 : p_.mouth_y + 0.6;
+        const double W = upper ? p_.teeth_half_width : p_.teeth_half_width - 2.0;
+        const double D = upper ? p_.teeth_depth : p_.teeth_depth - 1.5;
+        const double z0 = upper ? z_front : z_front - 2.2;  // lower incisors sit behind the upper ones
         const VertexPart part = upper ? VertexPart::MouthUpper : VertexPart::MouthLower;
-        const int first = face.vertex_count();
+        const std::vector<glm::dvec2>& crowns = upper ? p_.upper_crowns : p_.lower_crowns;
+        // The arch: x = W sin(tau), z = z0 - D (1 - cos(tau)); arc length by table.
+        constexpr int kTable = 400;
+        std::vector<double> arc(kTable + 1, 0.0);
+        auto at = [&](double tau) { return glm::dvec3{W * std::sin(tau), 0.0, z0 - D * (1.0 - std::cos(tau))}; };
+        const double tau_max = 0.5 * kPi;
+        for (int k = 1; k <= kTable; ++k)
+            arc[k] = arc[k - 1] + glm::length(at(tau_max * k / kTable) - at(tau_max * (k - 1) / kTable));
+        auto tau_of = [&](double sarc) {  // arc length from the midline -> tau (left side)
+            int k = 0;
+            while (k < kTable && arc[k + 1] < sarc) ++k;
+            const double f = (sarc - arc[k]) / std::max(arc[std::min(k + 1, kTable)] - arc[k], 1e-9);
+            return tau_max * (k + std::min(f, 1.0)) / kTable;
+        };
+        auto frame = [&](double sarc, double side, glm::dvec3& pos, glm::dvec3& along, glm::dvec3& out) {
+            const double tau = tau_of(sarc) * side;
+            pos = at(tau);
+            along = detail::normalised(glm::dvec3{W * std::cos(tau), 0.0, -D * std::sin(tau)});
+            out = detail::normalised(glm::dvec3{along.z, 0.0, -along.x});  // horizontal, away from the arch's inside
+            if (glm::dot(out, glm::dvec3{pos.x, 0.0, pos.z - (z0 - D)}) < 0) out = -out;
+        };
+        auto tile_uv = [&](double sarc, double c, double& u, double& v) {
+            // The painter's teeth tile (face_texture.cpp): c 0 gum .. 1 edge
+            // (front) .. 2 edge (back) .. 3 gum; k along the arch, where it
+            // paints the gaps of a one-piece arch. The crowns are apart here,
+            // so all take the column between its last two gaps (36 mm along
+            // the upper arch, 29 along the lower).
+            (void)sarc;
+            const double k = 0.5 + (upper ? 36.0 : 29.0) / p_.teeth_half_width / (0.92 * kPi);
+            u = detail::tile_u0(Tile::Teeth) + detail::kTile * (0.02 + 0.96 * k);
+            v = detail::kTile * ((upper ? 0.5 : 0.0) + 0.02 + 0.46 * c / 3.0);
+        };
+        std::vector<double> bounds{0.0};  // tooth boundaries along the arch (mm from the midline)
+        for (const glm::dvec2& c : crowns) bounds.push_back(bounds.back() + c[0]);
+        int first = -1;
+        constexpr int kLevels = 6, kRound = 14;
+        for (double side : {1.0, -1.0}) {
+            for (std::size_t t = 0; t < crowns.size(); ++t) {
+                const double width = crowns[t][0], height = crowns[t][1];
+                const bool incisor = t < 2, canine = t == 2;
+                const double s_mid = 0.5 * (bounds[t] + bounds[t + 1]);
+                glm::dvec3 pos, along, out;
+                frame(s_mid, side, pos, along, out);
+                // Cross-section half sizes along the arch (a) and across it (b) at f = 0 (gum) .. 1 (edge).
+                auto half_a = [&](double f) {
+                    const double w = 0.5 * width - 0.08;  // the crowns touch at their contact points
+                    if (canine) return w * (f < 0.6 ? detail::mix(0.8, 1.0, f / 0.6) : detail::mix(1.0, 0.25, (f - 0.6) / 0.4));
+                    if (incisor) return w * (f < 0.7 ? detail::mix(0.78, 1.0, f / 0.7) : 1.0);
+                    return w * detail::mix(0.85, 0.95, f);
+                };
+                auto half_b = [&](double f) {
+                    if (incisor) return detail::mix(3.2, 0.6, std::pow(f, 1.3));
+                    if (canine) return detail::mix(3.8, 1.2, f * f);
+                    return detail::mix(4.2, 3.6, f);
+                };
+                // Incisors lean forward to the edge; all sit on the arch.
+                const double lean = incisor ? 2.0 : (canine ? 1.0 : 0.0);
+                const int tooth_first = face.vertex_count();
+                if (first < 0) first = tooth_first;
+                double u, v;
+                for (int l = 0; l < kLevels; ++l) {
+                    const double f = static_cast<double>(l) / (kLevels - 1);
+                    const double y = y_edge + sign * height * (1.0 - f) + (upper ? 0.0 : 0.0);
+                    const glm::dvec3 c = pos + out * (lean * f - 0.5 * half_b(0.0)) + glm::dvec3{0, y, 0};
+                    for (int k = 0; k < kRound; ++k) {
+                        const double ang = 2 * kPi * k / kRound;
+                        const double ca = std::cos(ang), sa = std::sin(ang);
+                        // Superellipse of exponent 3: boxy but rounded.
+                        const double ex = 2.0 / 3.0;
+                        const double px = half_a(f) * (ca < 0 ? -1 : 1) * std::pow(std::abs(ca), ex);
+                        const double pz = half_b(f) * (sa < 0 ? -1 : 1) * std::pow(std::abs(sa), ex);
+                        // Labial side (pz > 0) maps to c 0..1, lingual to 3..2.
+                        tile_uv(side * s_mid, sa >= 0 ? 0.35 + 0.6 * f : 2.65 - 0.6 * f, u, v);
+                        u += detail::kTile * 0.02 * (static_cast<double>(k) / kRound - 0.5);  // texels to paint
+                        add_vertex(face, c + along * px + out * pz, u, v, part);
+                    }
+                }
+                tile_uv(side * s_mid, 1.0, u, v);
+                const glm::dvec3 tip = pos + out * (lean - 0.5 * half_b(0.0)) + glm::dvec3{0, y_edge - sign * 0.3, 0};
+                const int cap = add_vertex(face, tip, u, v, part).idx();
+                auto ring = [&](int l, int k) { return tooth_first + l * kRound + (k % kRound); };
+                // Out of the tooth: from its section's centre (the sections
+                // shift with the lean) to the vertex.
+                auto outward = [&](int a) {
+                    const int l = (a - tooth_first) / kRound;
+                    const double f = static_cast<double>(l) / (kLevels - 1);
+                    const glm::dvec3 c = pos + out * (lean * f - 0.5 * half_b(0.0));
+                    const auto q = face.mesh.point(TriMesh::VertexHandle(a));
+                    return glm::dvec3{q[0] - c.x, 0.0, q[2] - c.z};
+                };
+                for (int l = 0; l + 1 < kLevels; ++l)
+                    for (int k = 0; k < kRound; ++k) {
+                        add_oriented(face, ring(l, k), ring(l + 1, k), ring(l + 1, k + 1), outward(ring(l, k)));
+                        add_oriented(face, ring(l, k), ring(l + 1, k + 1), ring(l, k + 1), outward(ring(l, k + 1)));
+                    }
+                for (int k = 0; k < kRound; ++k)
+                    add_oriented(face, cap, ring(kLevels - 1, k), ring(kLevels - 1, k + 1), glm::dvec3{0, -sign, 0});
+                if (side > 0 && t == 0) {
+                    // 9.8 / 9.9: the front of the teeth at the gum; 9.10 / 9.11: the incisors' biting edge.
+                    const int labial = kRound / 4;  // ang = 90 deg: the labial face's middle
+                    (upper ? upper_gum_point_ : lower_gum_point_) = ring(0, labial);
+                    (upper ? upper_edge_point_ : lower_edge_point_) = ring(kLevels - 1, labial);
+                }
+            }
+        }
+        // The gum: a band over the crowns' necks along the whole arch, its
+        // edge scalloped down between the teeth (papillae).
+        const int sections = 48;
+        const double s_end = bounds.back();
+        const int gum_first = face.vertex_count();
         for (int k = 0; k <= sections; ++k) {
-            const double tau = (-0.5 + static_cast<double>(k) / sections) * kPi * 0.92;
-            const glm::dvec3 front{W * std::sin(tau), 0.0, z0 - p_.teeth_depth * (1.0 - std::cos(tau))};
-            // Inward normal of the arch, an ellipse centred at z0 - depth.
-            const double zc = z0 - p_.teeth_depth;
-            const glm::dvec3 in = detail::normalised(
-                glm::dvec3{-front.x / (W * W), 0.0, -(front.z - zc) / (p_.teeth_depth * p_.teeth_depth)});
-            const glm::dvec3 sec[4] = {front + glm::dvec3{0, y_root, 0}, front + glm::dvec3{0, y_edge, 0},
-                                       front + in * thickness + glm::dvec3{0, y_edge, 0},
-                                       front + in * thickness + glm::dvec3{0, y_root, 0}};
+            const double sarc = -s_end + 2.0 * s_end * k / sections;
+            glm::dvec3 pos, along, out;
+            frame(std::abs(sarc), sarc < 0 ? -1.0 : 1.0, pos, along, out);
+            double d = 1e9;
+            for (double b : bounds) d = std::min(d, std::abs(std::abs(sarc) - b));
+            if (std::abs(sarc) < 1e-6) d = 0.0;
+            std::size_t t = 0;
+            while (t + 1 < crowns.size() && std::abs(sarc) > bounds[t + 1]) ++t;
+            const double neck = y_edge + sign * crowns[t][1];
+            const double papilla = 2.2 * std::exp(-(d / 1.3) * (d / 1.3));
+            const double thick = (t < 2 ? 3.2 : (t == 2 ? 3.8 : 4.2)) + 0.7;
+            const glm::dvec3 mid = pos + out * (-0.5 * (t < 2 ? 3.2 : 3.8));
+            const glm::dvec3 sec[4] = {mid + out * thick + glm::dvec3{0, neck - sign * (0.6 + papilla), 0},
+                                       mid + out * (thick + 0.8) + glm::dvec3{0, neck + sign * 3.0, 0},
+                                       mid - out * (thick + 0.8) + glm::dvec3{0, neck + sign * 3.0, 0},
+                                       mid - out * thick + glm::dvec3{0, neck - sign * (0.6 + papilla), 0}};
+            const double cs[4] = {0.05, 0.0, 3.0, 2.95};
             for (int c = 0; c < 4; ++c) {
-                const double u = detail::tile_u0(Tile::Teeth) + detail::kTile * (0.02 + 0.96 * k / sections);
-                const double v = detail::kTile * ((upper ? 0.5 : 0.0) + 0.02 + 0.46 * c / 3.0);
+                double u, v;
+                tile_uv(sarc, cs[c], u, v);
                 add_vertex(face, sec[c], u, v, part);
             }
         }
-        for (int k = 0; k < sections; ++k) {
-            for (int c = 0; c < 4; ++c) {
-                const int c2 = (c + 1) % 4;
-                const int a = first + 4 * k + c, b = first + 4 * (k + 1) + c;
-                const int d = first + 4 * k + c2, e = first + 4 * (k + 1) + c2;
-                glm::dvec3 centre{0.0}, mid{0.0};
-                for (int q = 0; q < 4; ++q) {
-                    const auto pq = face.mesh.point(TriMesh::VertexHandle(first + 4 * k + q));
-                    centre = centre + glm::dvec3{pq[0], pq[1], pq[2]} * 0.25;
-                }
+        for (int k = 0; k < sections; ++k)
+            for (int c = 0; c < 3; ++c) {
+                const int a = gum_first + 4 * k + c, b = gum_first + 4 * (k + 1) + c;
+                const int d = gum_first + 4 * k + c + 1, e = gum_first + 4 * (k + 1) + c + 1;
                 const auto pa = face.mesh.point(TriMesh::VertexHandle(a));
                 const auto pd = face.mesh.point(TriMesh::VertexHandle(d));
-                mid = glm::dvec3{0.5 * (pa[0] + pd[0]), 0.5 * (pa[1] + pd[1]), 0.5 * (pa[2] + pd[2])};
-                add_oriented(face, a, b, e, mid - centre);
-                add_oriented(face, a, e, d, mid - centre);
+                glm::dvec3 out_dir;
+                if (c == 0) {
+                    glm::dvec3 pos, along, out;
+                    frame(std::abs(-s_end + 2.0 * s_end * k / sections), k < sections / 2 ? -1.0 : 1.0, pos, along, out);
+                    out_dir = out;
+                } else if (c == 1) {
+                    out_dir = {0, sign, 0};
+                } else {
+                    glm::dvec3 pos, along, out;
+                    frame(std::abs(-s_end + 2.0 * s_end * k / sections), k < sections / 2 ? -1.0 : 1.0, pos, along, out);
+                    out_dir = -out;
+                }
+                (void)pa;
+                (void)pd;
+                add_oriented(face, a, b, e, out_dir);
+                add_oriented(face, a, e, d, out_dir);
             }
-        }
         return first;
     };
-    upper_teeth_first_ = arch(true);
-    lower_teeth_first_ = arch(false);
+    arch(true);
+    arch(false);
 
     // Tongue: an ellipsoid resting on the cavity floor, tip (+z pole) forward.
     {
@@ -856,11 +984,10 @@ void Generator::place_feature_points(Face& face) {
         set_vertex("6.2", tongue_first_ + 1 + mid_ring * segs + segs / 4);
         set_vertex("6.3", tongue_first_ + 1 + mid_ring * segs);
         set_vertex("6.4", tongue_first_ + 1 + mid_ring * segs + segs / 2);
-        const int centre_section = (teeth_sections_ - 1) / 2;
-        set_vertex("9.8", upper_teeth_first_ + 4 * centre_section + 0);
-        set_vertex("9.9", lower_teeth_first_ + 4 * centre_section + 0);
-        set_vertex("9.10", upper_teeth_first_ + 4 * centre_section + 1);
-        set_vertex("9.11", lower_teeth_first_ + 4 * centre_section + 1);
+        set_vertex("9.8", upper_gum_point_);
+        set_vertex("9.9", lower_gum_point_);
+        set_vertex("9.10", upper_edge_point_);
+        set_vertex("9.11", lower_edge_point_);
     }
     set_vertex("11.4", pole_);
     {

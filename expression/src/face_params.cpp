@@ -107,6 +107,12 @@ FaceParams read_face_params(const std::string& params_dir) {
             p.shoulders = read_ellipsoid(shoulders);
             p.shoulders_blend = shoulders.number_in("blend", 0.0, 200.0);
             shoulders.finish();
+            JsonReader hv = r.object("hair_volume");
+            p.hair_volume.top = hv.number_in("top", 0.0, 40.0);
+            p.hair_volume.sides = hv.number_in("sides", 0.0, 40.0);
+            p.hair_volume.nape = hv.number_in("nape", 0.0, 40.0);
+            p.hair_volume.fade = hv.number_in("fade", 0.5, 60.0);
+            hv.finish();
             r.finish();
         }
         {
@@ -171,7 +177,13 @@ FaceParams read_face_params(const std::string& params_dir) {
             p.cavity_centre = to_glm(r.numbers<3>("cavity_centre"));
             p.cavity_radii = to_glm(r.numbers<3>("cavity_radii"));
             p.teeth_half_width = r.number("teeth_half_width");
-            p.teeth_height = r.number("teeth_height");
+            for (auto [key, crowns] : {std::pair{"upper_crowns", &p.upper_crowns}, std::pair{"lower_crowns", &p.lower_crowns}}) {
+                const JsonReader list = r.at(key);
+                for (const JsonReader& c : list.elements()) crowns->push_back(to_glm(c.as_numbers<2>()));
+                if (crowns->size() < 3) list.fail("at least 3 crowns (incisors and a canine)");
+                for (const glm::dvec2& c : *crowns)
+                    if (!(c[0] > 1.0 && c[1] > 1.0)) list.fail("crowns of width and height above 1 mm");
+            }
             p.teeth_depth = r.number("teeth_depth");
             p.teeth_gap = r.number("teeth_gap");
             p.tongue_centre = to_glm(r.numbers<3>("tongue_centre"));

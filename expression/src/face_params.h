@@ -100,6 +100,11 @@ struct FaceParams {
     double neck_top_y = 0.0, neck_lean_deg = 0.0, neck_blend = 0.0;
     Ellipsoid shoulders;
     double shoulders_blend = 0.0;
+    // the hair's volume off the scalp (mm) over the crown, on the sides and
+    // at the nape, and over how many mm above the hairline it grows to that
+    struct HairVolume {
+        double top = 0.0, sides = 0.0, nape = 0.0, fade = 1.0;
+    } hair_volume;
 
     // eyes (left eye; the right one mirrors it)
     glm::dvec3 eye_centre{0.0};
@@ -134,7 +139,9 @@ struct FaceParams {
     // mouth interior
     glm::dvec3 cavity_centre{0.0};
     glm::dvec3 cavity_radii{0.0};
-    double teeth_half_width = 0.0, teeth_height = 0.0, teeth_depth = 0.0;
+    double teeth_half_width = 0.0, teeth_depth = 0.0;
+    // crowns from the midline out: width along the arch, crown height (mm)
+    std::vector<glm::dvec2> upper_crowns, lower_crowns;
     double teeth_gap = 0.0;
     glm::dvec3 tongue_centre{0.0};
     glm::dvec3 tongue_radii{0.0};

@@ -346,6 +346,33 @@ double FaceShape::ear_relief(double y, double z) const {
     return std::max(h * edge, 0.0);
 }
 
+double FaceShape::hairline(glm::dvec3 q) const {
+    const double ax = std::abs(q.x);
+    const double tx = std::min(ax / p_.hairline_temple[0], 1.0);
+    const double front_line =
+        mix(p_.hairline_y, p_.hairline_temple[1], tx * tx) - std::max(ax - p_.hairline_temple[0], 0.0) * 2.5;
+    const double ear_top = p_.ear_centre_yz[0] + p_.ear_radii_yz[0] + 5.0;
+    const double ear_front = p_.ear_centre_yz[1] + p_.ear_radii_yz[1] + 3.0;
+    const double ear_back = p_.ear_centre_yz[1] - p_.ear_radii_yz[1] - 3.0;
+    double side_line;
+    if (q.z > ear_front) side_line = mix(ear_top, p_.sideburn_bottom_y, glm::smoothstep(ear_front, ear_front + 5.0, q.z));
+    else if (q.z > ear_back) side_line = ear_top;
+    else side_line = mix(ear_top, p_.hair_back_bottom_y, glm::smoothstep(ear_back, ear_back - 35.0, q.z));
+    return mix(side_line, front_line, glm::smoothstep(p_.sideburn_z - 6.0, p_.sideburn_z + 6.0, q.z));
+}
+
+double FaceShape::hair_thickness(glm::dvec3 base, glm::dvec3 n) const {
+    const FaceParams::HairVolume& v = p_.hair_volume;
+    const double above = base.y - hairline(base);
+    if (above <= 0.0) return 0.0;
+    // A short haircut: fullest over the crown, close on the sides and
+    // thinning down the nape; it rises from the hairline over `fade` mm.
+    const double side = std::abs(n.x);
+    double t = mix(v.top, v.sides, glm::smoothstep(0.35, 0.9, side));
+    t = mix(v.nape, t, glm::smoothstep(-60.0, 20.0, base.y));
+    return t * glm::smoothstep(0.0, v.fade, above);
+}
+
 glm::dvec3 FaceShape::displace(glm::dvec3 base) const {
     const glm::dvec3 n = field_normal(base);
     glm::dvec3 p = base;
@@ -361,6 +388,8 @@ glm::dvec3 FaceShape::displace(glm::dvec3 base) const {
         const double e = ear_relief(base.y, base.z) * side;
         if (e > 0.0) p = p + n * e;
     }
+    const double hair = hair_thickness(base, n);
+    if (hair > 0.0) p = p + n * hair;
     return p;
 }
 

@@ -82,6 +82,14 @@ public:
     // 1 the front edge where the ear joins the head).
     glm::dvec2 ear_point(double a, double s) const;
 
+    // The hairline's height (y) at a point of the head, from face.json
+    // "hair" (the front line over the forehead and temples, the sideburn,
+    // over the ear, down to the nape); no noise.
+    double hairline(glm::dvec3 q) const;
+    // How far the hair stands off the scalp at a head-volume point with
+    // outward normal n (0 below the hairline).
+    double hair_thickness(glm::dvec3 base, glm::dvec3 n) const;
+
     // Depth of the nostril dents at (x, y) as a fraction 0..1 (for painting).
     double nostril_amount(double x, double y) const;
 
