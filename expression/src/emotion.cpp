@@ -134,8 +134,11 @@ EmotionMix parse_emotion_mix(std::string_view text, bool normalise) {
         if (!au_error.empty()) bad(fmt::format("{}: {}", where, au_error));
         const bool is_neutral = lower(name) == "neutral";
         const auto e = find_emotion(name);
-        if (!e && !is_neutral && !au)
-            bad(fmt::format("unknown emotion \"{}\" in {}; {}", echo_input(name, 40), where, kExpected));
+        if (!e && !is_neutral && !au) {
+            // The part is shown only when it says more than the name.
+            const std::string in = name == part ? fmt::format("part {}", number) : where;
+            bad(fmt::format("unknown emotion \"{}\" in {}; {}", echo_input(name, 40), in, kExpected));
+        }
         if (w < 0) bad(fmt::format("{}: weight {:g} is negative; weights are in [0, 1]", where, w));
         if (w > 1) bad(fmt::format("{}: weight {:g} is above 1; weights are in [0, 1]", where, w));
         if (au) {

@@ -52,16 +52,13 @@ std::string with_commas(long long n) {
 
 // Adds triangles to a mesh with OpenMesh's own per-triangle complaints
 // ("PolyMeshT::add_face: complex edge", one line each; 98,120 for one bad
-// file) captured instead of printed, and counted by kind for one message.
+// file) switched off, counted by kind for one message instead. (Switched off
+// rather than redirected: OpenMesh's stream leaks what connect() allocates.)
 class TriangleAdder {
 public:
-    explicit TriangleAdder(TriMesh& mesh) : mesh_(mesh) {
-        ::omerr().disconnect(std::cerr);
-        ::omerr().connect(captured_);
-    }
+    explicit TriangleAdder(TriMesh& mesh) : mesh_(mesh), was_enabled_(::omerr().is_enabled()) { ::omerr().disable(); }
     ~TriangleAdder() {
-        ::omerr().disconnect(captured_);
-        ::omerr().connect(std::cerr);
+        if (was_enabled_) ::omerr().enable();
     }
     TriangleAdder(const TriangleAdder&) = delete;
     TriangleAdder& operator=(const TriangleAdder&) = delete;
@@ -69,27 +66,31 @@ public:
     // Whether the triangle was added; a rejected one is counted and, the
     // first time, `line` (the file's line it came from) kept.
     bool add(int a, int b, int c, std::size_t line) {
-        if (mesh_.add_face(TriMesh::VertexHandle(a), TriMesh::VertexHandle(b), TriMesh::VertexHandle(c)).is_valid())
-            return true;
+        const TriMesh::VertexHandle v[3] = {TriMesh::VertexHandle(a), TriMesh::VertexHandle(b), TriMesh::VertexHandle(c)};
+        if (mesh_.add_face(v[0], v[1], v[2]).is_valid()) return true;
         if (rejected_++ == 0) first_line_ = line;
+        // OpenMesh's two reasons: an edge that already has a triangle on
+        // this side, or a vertex whose fan is already closed.
+        bool edge = false;
+        for (int k = 0; k < 3; ++k) {
+            const auto h = mesh_.find_halfedge(v[k], v[(k + 1) % 3]);
+            edge = edge || (h.is_valid() && !mesh_.is_boundary(h));
+        }
+        (edge ? complex_edges_ : complex_vertices_)++;
         return false;
     }
     long long rejected() const { return rejected_; }
     std::size_t first_line() const { return first_line_; }
-    // "complex edges" / "complex vertices" / both, from what OpenMesh said.
-    std::string kinds() {
-        ::omerr().flush();
-        const std::string text = captured_.str();
-        std::string out;
-        for (auto [needle, name] : {std::pair{"complex edge", "complex edges"}, {"complex vertex", "complex vertices"}})
-            if (text.find(needle) != std::string::npos) out += (out.empty() ? "" : " and ") + std::string(name);
-        return out.empty() ? "edges or vertices shared in a way a manifold mesh cannot hold" : out;
+    // "complex edges" / "complex vertices" / both.
+    std::string kinds() const {
+        if (complex_edges_ > 0 && complex_vertices_ > 0) return "complex edges and complex vertices";
+        return complex_edges_ > 0 ? "complex edges" : "complex vertices";
     }
 
 private:
     TriMesh& mesh_;
-    std::ostringstream captured_;
-    long long rejected_ = 0;
+    bool was_enabled_;
+    long long rejected_ = 0, complex_edges_ = 0, complex_vertices_ = 0;
     std::size_t first_line_ = 0;
 };
 

@@ -22,7 +22,7 @@ std::string syntax_detail(const std::string& what) {
 
 // Keys and values are the file's text: shown cut and with control
 // characters escaped, so a message stays one short line.
-constexpr std::size_t kMaxShownKey = 40;
+constexpr std::size_t kMaxShownKey = 24;
 constexpr int kMaxDepth = 256;  // nesting of arrays and objects; data files use < 10
 
 // A key as it appears in a path: plain when it is a name or a number, quoted
