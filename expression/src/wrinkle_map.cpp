@@ -237,9 +237,10 @@ void resolve_strokes(const std::vector<WrinkleSpec>& specs, const FoldShape& sha
         const float sigma = spec.width * unit;
         // A valley with its shoulders on the wide flank reaches this far.
         const float wide = 1.0f + shape.asymmetry;
-        const float reach = spec.profile == WrinkleProfile::Fold
-                                ? 6.0f * wide * sigma
-                                : (shape.shoulder_offset + 3.0f * shape.shoulder_width) * wide * sigma;
+        const float reach = std::max(spec.profile == WrinkleProfile::Fold
+                                         ? 6.0f * wide * sigma
+                                         : (shape.shoulder_offset + 3.0f * shape.shoulder_width) * wide * sigma,
+                                     3.0f * shape.wall_width * wide * sigma);
         if (curve.size() == 1) {  // a round mark: no along-the-fold shape
             strokes.push_back(make_stroke(spec.profile, curve, scale * spec.depth * unit, sigma, 0.0f, spec.side,
                                           0.0f, false, 3.0f * sigma));
@@ -333,18 +334,23 @@ float stroke_height(const Stroke& s, const FoldShape& shape, float unit, glm::ve
     // Across: the flank on the `side` of the curve is steeper than the other.
     const bool steep = s.side * signed_best >= 0.0f;
     const float flank = sigma * (steep ? 1.0f - shape.asymmetry : 1.0f + shape.asymmetry);
+    // The valley: a sharp narrow core (dark in its cavity) in broad shallow
+    // walls, so the wall that faces the light catches little of it.
+    const float valley = shape.core * bump(best, shape.core_width * flank) +
+                         (1.0f - shape.core) * bump(best, shape.wall_width * flank);
     switch (s.profile) {
         case WrinkleProfile::Groove:
         case WrinkleProfile::Dimple:
             // Compressed skin buckles into a narrow valley with broad rounded
             // crests beside it (FIDELITY.md 6, HARR).
-            return depth * (-bump(best, flank) +
-                            shape.shoulder * bump(best - shape.shoulder_offset * flank, shape.shoulder_width * flank));
+            // The skin bunches higher beside the steep flank than the gentle one.
+            return depth * (-valley + shape.shoulder * (steep ? 1.0f + 0.5f * shape.asymmetry : 1.0f - 0.5f * shape.asymmetry) *
+                                          bump(best - shape.shoulder_offset * flank, shape.shoulder_width * flank));
         case WrinkleProfile::Bulge:
             return depth * bump(best, sigma);
         case WrinkleProfile::Fold:
             // The cheek bulges over the `side` flank; the other keeps a small shoulder.
-            return depth * (-bump(best, flank) + 0.5f * bump(s.side * signed_best - 2.0f * sigma, 1.5f * sigma) +
+            return depth * (-valley + 0.5f * bump(s.side * signed_best - 2.0f * sigma, 1.5f * sigma) +
                             0.5f * shape.shoulder *
                                 bump(-s.side * signed_best - shape.shoulder_offset * flank,
                                      shape.shoulder_width * flank));
@@ -527,6 +533,9 @@ WrinkleLibrarySpec load_wrinkle_spec(const std::string& path) {
             fs.shoulder_offset = read_number(f, "shoulder_offset", fs.shoulder_offset, 0.5f, 5.0f);
             fs.shoulder_width = read_number(f, "shoulder_width", fs.shoulder_width, 0.2f, 3.0f);
             fs.asymmetry = read_number(f, "asymmetry", fs.asymmetry, 0.0f, 0.8f);
+            fs.core = read_number(f, "core", fs.core, 0.0f, 1.0f);
+            fs.core_width = read_number(f, "core_width", fs.core_width, 0.1f, 1.0f);
+            fs.wall_width = read_number(f, "wall_width", fs.wall_width, 1.0f, 3.0f);
             fs.meander = read_number(f, "meander", fs.meander, 0.0f, 3.0f);
             fs.meander_wavelength = read_number(f, "meander_wavelength", fs.meander_wavelength, 0.01f, 2.0f);
             fs.swell = read_number(f, "swell", fs.swell, 0.0f, 0.9f);

@@ -61,6 +61,9 @@ struct FoldShape {
     float shoulder_offset = 2.2f;    // crest distance from the valley floor
     float shoulder_width = 1.3f;     // crest sigma
     float asymmetry = 0.3f;          // one flank (sigma * (1 - a)) steeper than the other (1 + a)
+    float core = 0.55f;              // share of the depth in a sharp narrow core of the valley ...
+    float core_width = 0.5f;         // ... this wide; the rest over broad shallow walls ...
+    float wall_width = 1.6f;         // ... this wide (both in flank sigmas)
     float meander = 0.5f;            // sideways wander of the valley floor
     float meander_wavelength = 0.25f;  // face units
     float swell = 0.35f;             // depth variation along the fold, +- fraction
