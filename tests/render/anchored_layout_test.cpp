@@ -194,19 +194,19 @@ protected:
         const float gap = glm::distance(in_l, in_r);
         const glm::vec2 up(0.0f, -1.0f);  // up the face = up the painted image
         if (key == "anger") {
-                for (const float t : {0.3f, 0.7f}) {
-                    const glm::vec2 base = glm::mix(in_r, in_l, t);
-                    canvas.stroke(base + 0.05f * gap * up, base + 0.5f * gap * up, -0.006f, 2.5f);
-                }
+            for (const float t : {0.3f, 0.7f}) {
+                const glm::vec2 base = glm::mix(in_r, in_l, t);
+                canvas.stroke(base + 0.05f * gap * up, base + 0.5f * gap * up, -0.006f, 2.5f);
+            }
         } else if (key == "surprise") {
-                const glm::vec2 mid_l = painted_at(f, "4.3"), mid_r = painted_at(f, "4.4");
-                for (const float h : {0.35f, 0.6f, 0.85f})
-                    canvas.stroke(mid_r + h * gap * up, mid_l + h * gap * up, -0.005f, 3.0f);
+            const glm::vec2 mid_l = painted_at(f, "4.3"), mid_r = painted_at(f, "4.4");
+            for (const float h : {0.35f, 0.6f, 0.85f})
+                canvas.stroke(mid_r + h * gap * up, mid_l + h * gap * up, -0.005f, 3.0f);
         } else if (key == "joy") {
-                for (const char* id : {"5.3", "5.4"}) {
-                    const glm::vec2 c = painted_at(f, id);
-                    canvas.stroke(c, c, 0.012f, 7.0f);
-                }
+            for (const char* id : {"5.3", "5.4"}) {
+                const glm::vec2 c = painted_at(f, id);
+                canvas.stroke(c, c, 0.012f, 7.0f);
+            }
         }
     }
 
