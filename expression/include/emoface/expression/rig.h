@@ -6,16 +6,18 @@
 // direction (x = face's left, y = up, z = to the viewer). Vertices follow
 // through the influence weights computed once in the constructor:
 //  - point FAPs (lips, chin boss, eyelids, brows, cheeks, nose, ears, tongue)
-//    act through a compact Shepard interpolation of the feature points'
-//    displacements over geodesic (along-the-mesh) distance, so an upper-lip
-//    FAP never reaches the lower lip across the closed mouth and a lid never
-//    reaches the other lid. The weights are infinite at a feature point, so
-//    each moves exactly by its own FAPs and no other, and fade to nothing at
-//    a radius scaled by ES0. Feature points no FAP moves that should stay put
-//    (eye corners, nose base, hairline, jaw corners, ear roots) are anchors.
+//    move the skin as a sheet: a smooth partition of unity of C2 bells over
+//    geodesic (along-the-mesh) distance, corrected so that each feature
+//    point moves exactly by its own FAPs. Distances along the skin keep an
+//    upper-lip FAP off the lower lip across the closed mouth and a lid off
+//    the other lid. Feature points no FAP moves that should stay put (eye
+//    corners, nose base, jaw corners, ear roots) are anchors. A frame's
+//    FAPs are first clamped to human ranges (RigOptions::ranges) and the
+//    inner and outer lip contours move together;
 //  - on a face with eyeballs and eyelid margins, FAPs 19-22 close a lid along
-//    its whole length (the margin moves by the lid opening at each point) and
-//    lid skin slides over the eyeball instead of sinking into it;
+//    its whole length (the margin moves by the lid opening at each point),
+//    lid skin slides over the eyeball instead of sinking into it, and the
+//    upper lid's inner part follows the inner brow;
 //  - FAP 3 (open_jaw) rotates the jaw, lower lip and chin about the jaw pivot
 //    so that 2.1 drops by value x MNS; 14 and 15 translate the jaw;
 //  - FAPs 23-28 rotate and thrust the eyeballs about their centres, 29/30
