@@ -171,7 +171,9 @@ private:
 };
 
 void Generator::make_columns() {
-    int front = scaled(p_.front_columns, scale_, 8);
+    // At least the columns the eye opening and the mouth need (4 each, see
+    // below): resolutions down to 0.1 coarsen the rows, not the features.
+    int front = scaled(p_.front_columns, scale_, 56);
     if (front % 2) ++front;
     int back = scaled(p_.back_columns, scale_, 4);
     if (back % 2) ++back;
