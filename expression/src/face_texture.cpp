@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <vector>
+
+#include <glm/trigonometric.hpp>
+#include <glm/geometric.hpp>
 
 #include "eye_texture.h"
 
@@ -46,56 +50,184 @@ double fbm(double x, double y, double z) {
     return 0.5 * noise(x, y, z) + 0.3 * noise(2.1 * x, 2.1 * y, 2.1 * z) + 0.2 * noise(4.3 * x, 4.3 * y, 4.3 * z);
 }
 
+struct Texel {
+    Rgb colour;
+    double gloss = 1.0;  // roughness scale (the base map's alpha)
+};
+
+// One brow hair: a stroke from its root along `dir` (unit, frontal x/y mm).
+struct BrowHair {
+    glm::dvec2 root, dir;
+    double length, width, shade;
+};
+
 class Painter {
 public:
-    explicit Painter(const FaceShape& shape) : s_(shape), p_(shape.params()) {}
+    explicit Painter(const FaceShape& shape);
 
-    Rgb skin(glm::dvec3 q) const;
+    Texel skin(glm::dvec3 q) const;
     Rgb tile(double u, double v) const;
 
 private:
-    double brow_density(double x, double y) const;
-    bool hair(glm::dvec3 q, double* amount) const;
+    // Where (x, y) lies against a brow's centre line: t 0 (inner) .. 1
+    // (outer), signed distance above the line (mm), and the line's outward
+    // unit tangent there.
+    struct BrowPlace {
+        double t, above, distance, half;
+        glm::dvec2 tangent;
+    };
+    BrowPlace brow_place(double x, double y) const;
+    double brow_density(const BrowPlace& b) const;
+    // Brow hairs' coverage at (x, y) and their colour.
+    double brow_hairs(double x, double y, Rgb* colour) const;
+    double hair(glm::dvec3 q, Rgb* colour) const;
 
     const FaceShape& s_;
     const FaceParams& p_;
+    std::vector<BrowHair> hairs_;
+    // hairs_ bucketed on a grid of kBucket mm over the brows' box.
+    static constexpr double kBucket = 2.0;
+    glm::dvec2 grid_min_{0.0};
+    int grid_w_ = 0, grid_h_ = 0;
+    std::vector<std::vector<int>> grid_;
 };
 
-double Painter::brow_density(double x, double y) const {
+Painter::BrowPlace Painter::brow_place(double x, double y) const {
     const double sx = x >= 0 ? 1.0 : -1.0;
     const glm::dvec2 a{p_.brow_points[0][0] * sx, p_.brow_points[0][1]};
     const glm::dvec2 m{p_.brow_points[1][0] * sx, p_.brow_points[1][1]};
     const glm::dvec2 b{p_.brow_points[2][0] * sx, p_.brow_points[2][1]};
     // Quadratic curve through a, m (at t = 0.5) and b.
-    const glm::dvec2 c{2 * m[0] - 0.5 * (a[0] + b[0]), 2 * m[1] - 0.5 * (a[1] + b[1])};
-    double best = 1e9, best_t = 0, best_sd = 0;
+    const glm::dvec2 c = 2.0 * m - 0.5 * (a + b);
+    auto at = [&](double t) { return (1 - t) * (1 - t) * a + 2 * t * (1 - t) * c + t * t * b; };
+    double best = 1e9, best_t = 0;
     constexpr int kSamples = 48;
     for (int k = 0; k <= kSamples; ++k) {
         const double t = static_cast<double>(k) / kSamples;
-        const double px = (1 - t) * (1 - t) * a[0] + 2 * t * (1 - t) * c[0] + t * t * b[0];
-        const double py = (1 - t) * (1 - t) * a[1] + 2 * t * (1 - t) * c[1] + t * t * b[1];
-        const double d = std::hypot(x - px, y - py);
+        const double d = glm::length(glm::dvec2{x, y} - at(t));
         if (d < best) {
             best = d;
             best_t = t;
-            best_sd = y - py;
         }
     }
+    BrowPlace p;
+    p.t = best_t;
+    p.distance = best;
+    p.above = y - at(best_t)[1];
+    const glm::dvec2 d = 2.0 * (1 - best_t) * (c - a) + 2.0 * best_t * (b - c);
+    p.tangent = glm::length(d) > 1e-9 ? glm::normalize(d) : glm::dvec2{sx, 0.0};
     const double th = best_t < 0.5 ? mix(p_.brow_thickness[0], p_.brow_thickness[1], best_t * 2)
                                    : mix(p_.brow_thickness[1], p_.brow_thickness[2], best_t * 2 - 1);
-    // Brows sit mostly above their centre line at the inner end.
-    const double half = 0.5 * th;
-    const double q = best / half;
-    if (q > 1.3) return 0.0;
-    double m_edge = 1.0 - glm::smoothstep(0.55, 1.15, q);
-    m_edge *= 0.55 + 0.45 * glm::smoothstep(0.0, 0.22, best_t);  // sparse at the inner end
-    (void)best_sd;
-    // Hair strands: noise stretched along the brow (mostly horizontal).
-    const double strands = noise(x * 0.9, y * 3.2, 7.0) * 0.6 + noise(x * 2.3, y * 6.0, 3.0) * 0.4;
-    return std::clamp(m_edge * (0.55 + 0.7 * strands), 0.0, 1.0);
+    p.half = 0.5 * th;
+    return p;
 }
 
-bool Painter::hair(glm::dvec3 q, double* amount) const {
+// How densely hairs grow: 1 in the brow's body, thinning at its edges and
+// towards the inner end, with gaps.
+double Painter::brow_density(const BrowPlace& b) const {
+    const double q = b.distance / b.half;
+    if (q > 1.4 || (b.t <= 0.0 && b.distance > 0.3 * b.half)) return 0.0;
+    double d = 1.0 - glm::smoothstep(0.5, 1.3, q);
+    d *= 0.5 + 0.5 * glm::smoothstep(0.0, 0.25, b.t);  // sparse at the inner end
+    d *= 1.0 - 0.6 * glm::smoothstep(0.8, 1.0, b.t);    // and thinning to the tail
+    return d;
+}
+
+Painter::Painter(const FaceShape& shape) : s_(shape), p_(shape.params()) {
+    const double step = p_.brow_hair_spacing;
+    const double x0 = p_.brow_points[0][0] - 6.0, x1 = p_.brow_points[2][0] + 4.0;
+    double y0 = 1e9, y1 = -1e9;
+    for (const auto& bp : p_.brow_points) {
+        y0 = std::min(y0, bp[1]);
+        y1 = std::max(y1, bp[1]);
+    }
+    y0 -= 0.6 * p_.brow_thickness[0] + 2.0;
+    y1 += 0.6 * p_.brow_thickness[0] + 2.0;
+    const double medial = glm::radians(p_.brow_medial_angle), lateral = glm::radians(p_.brow_lateral_angle);
+    for (int side = 0; side < 2; ++side) {
+        const double sx = side == 0 ? 1.0 : -1.0;
+        int j = 0;
+        for (double y = y0; y < y1; y += step, ++j) {
+            int i = 0;
+            for (double x = x0; x < x1; x += step, ++i) {
+                // The two sides get different hairs (no mirrored copy).
+                const double jx = x + step * (hash(i, j, 31 + side) - 0.5), jy = y + step * (hash(i, j, 37 + side) - 0.5);
+                const BrowPlace b = brow_place(sx * jx, jy);
+                if (hash(i, j, 41 + side) > brow_density(b)) continue;
+                // Direction: the medial hairs grow up (and a little outward),
+                // the lateral ones outward along the line, converging on it.
+                const glm::dvec2 along = b.tangent;
+                const glm::dvec2 up{-along[1] * sx, along[0] * sx};  // the line's normal, pointing up
+                const double side_tilt = -lateral * std::clamp(b.above / b.half, -1.0, 1.0);
+                const double lateral_angle = side_tilt + 0.25 * (hash(i, j, 43 + side) - 0.5);
+                const double w = glm::smoothstep(0.08, 0.32, b.t);
+                const double angle = mix(medial + 0.3 * (hash(i, j, 47 + side) - 0.5), lateral_angle, w);
+                glm::dvec2 dir = std::cos(angle) * along + std::sin(angle) * up;
+                dir = glm::normalize(dir);
+                BrowHair h;
+                h.dir = dir;
+                h.length = mix(p_.brow_hair_length[0], p_.brow_hair_length[1], w) * (0.75 + 0.5 * hash(i, j, 53 + side));
+                // Roots sit back along the hair so its middle lies where it was drawn.
+                h.root = glm::dvec2{sx * jx, jy} - 0.45 * h.length * dir;
+                h.width = p_.brow_hair_width * (0.8 + 0.4 * hash(i, j, 59 + side));
+                h.shade = 0.7 + 0.6 * hash(i, j, 61 + side);
+                hairs_.push_back(h);
+            }
+        }
+    }
+    grid_min_ = {-x1 - 10.0, y0 - 10.0};
+    grid_w_ = static_cast<int>(std::ceil((2.0 * x1 + 20.0) / kBucket));
+    grid_h_ = static_cast<int>(std::ceil((y1 - y0 + 20.0) / kBucket));
+    grid_.assign(static_cast<std::size_t>(grid_w_) * grid_h_, {});
+    for (int k = 0; k < static_cast<int>(hairs_.size()); ++k) {
+        const BrowHair& h = hairs_[static_cast<std::size_t>(k)];
+        const glm::dvec2 tip = h.root + h.length * h.dir;
+        const double r = h.width + 0.5;
+        const int gx0 = static_cast<int>(std::floor((std::min(h.root[0], tip[0]) - r - grid_min_[0]) / kBucket));
+        const int gx1 = static_cast<int>(std::floor((std::max(h.root[0], tip[0]) + r - grid_min_[0]) / kBucket));
+        const int gy0 = static_cast<int>(std::floor((std::min(h.root[1], tip[1]) - r - grid_min_[1]) / kBucket));
+        const int gy1 = static_cast<int>(std::floor((std::max(h.root[1], tip[1]) + r - grid_min_[1]) / kBucket));
+        for (int gy = std::max(gy0, 0); gy <= std::min(gy1, grid_h_ - 1); ++gy)
+            for (int gx = std::max(gx0, 0); gx <= std::min(gx1, grid_w_ - 1); ++gx)
+                grid_[static_cast<std::size_t>(gy) * grid_w_ + gx].push_back(k);
+    }
+}
+
+double Painter::brow_hairs(double x, double y, Rgb* colour) const {
+    const int gx = static_cast<int>(std::floor((x - grid_min_[0]) / kBucket));
+    const int gy = static_cast<int>(std::floor((y - grid_min_[1]) / kBucket));
+    if (gx < 0 || gy < 0 || gx >= grid_w_ || gy >= grid_h_) return 0.0;
+    const Rgb brow = from255(p_.brows);
+    double clear = 1.0;  // the share of skin no hair covers
+    Rgb sum{};
+    double weight = 0.0;
+    for (int k : grid_[static_cast<std::size_t>(gy) * grid_w_ + gx]) {
+        const BrowHair& h = hairs_[static_cast<std::size_t>(k)];
+        const glm::dvec2 rel = glm::dvec2{x, y} - h.root;
+        const double along = glm::dot(rel, h.dir) / h.length;
+        if (along < -0.05 || along > 1.05) continue;
+        const double across = std::abs(rel[0] * h.dir[1] - rel[1] * h.dir[0]);
+        // Tapering to the tip; the edge softened over about a texel so thin
+        // hairs stay continuous strokes in the texture.
+        const double half = 0.5 * h.width * (1.0 - 0.55 * std::clamp(along, 0.0, 1.0));
+        const double cover = (1.0 - glm::smoothstep(half, half + 0.22, across)) *
+                             glm::smoothstep(-0.05, 0.05, along) * (1.0 - glm::smoothstep(0.92, 1.05, along));
+        if (cover <= 0.0) continue;
+        clear *= 1.0 - 0.8 * cover;
+        // Lighter towards the tip, where the hair is thinner.
+        const double shade = h.shade * (0.85 + 0.35 * std::clamp(along, 0.0, 1.0));
+        sum = {sum.r + brow.r * shade * cover, sum.g + brow.g * shade * cover, sum.b + brow.b * shade * cover};
+        weight += cover;
+    }
+    if (weight <= 0.0) return 0.0;
+    *colour = sum * (1.0 / weight);
+    return 1.0 - clear;
+}
+
+// Hair of the scalp: 0 (skin) .. 1, and its colour. The strands run from the
+// crown over the surface; strand coordinates are the azimuth round the crown
+// (across) and the distance from it (along).
+double Painter::hair(glm::dvec3 q, Rgb* colour) const {
     const double ax = std::abs(q.x);
     // Front: the hairline over the forehead, dropping at the temples.
     const double tx = std::min(ax / p_.hairline_temple[0], 1.0);
@@ -111,18 +243,55 @@ bool Painter::hair(glm::dvec3 q, double* amount) const {
     else if (q.z > ear_back) side_line = ear_top;
     else side_line = mix(ear_top, p_.hair_back_bottom_y, glm::smoothstep(ear_back, ear_back - 35.0, q.z));
     const double line = mix(side_line, front_line, glm::smoothstep(p_.sideburn_z - 6.0, p_.sideburn_z + 6.0, q.z));
-    double edge = q.y - line;
+    // Height above the hairline, its course wandering gently (low-frequency
+    // only: a saw-tooth edge reads as a wig).
+    double edge = q.y - line + (noise(q.x * 0.09, q.y * 0.09, q.z * 0.09 + 5.0) - 0.5) * 4.0;
     // Leave the ears bare.
-    if (ax > 55 && s_.ear_relief(q.y, q.z) > 0.3) edge = std::min(edge, -2.0);
-    edge += (noise(q.x * 0.4, q.y * 0.4, q.z * 0.4) - 0.5) * 3.0;
-    *amount = glm::smoothstep(-1.0, 2.5, edge);
-    return *amount > 0.0;
+    if (ax > 55 && s_.ear_relief(q.y, q.z) > 0.3) edge = std::min(edge, -4.0);
+    const double band = p_.hairline_band;
+    if (edge < -0.4 * band) return 0.0;
+
+    // Strand coordinates round the crown.
+    const double along = glm::length(q - p_.hair_crown);
+    const glm::dvec3 axis = glm::normalize(p_.hair_crown - glm::dvec3{0.0, 0.0, 0.0});
+    glm::dvec3 e1 = glm::normalize(glm::cross(axis, glm::dvec3{1.0, 0.0, 0.0}));
+    glm::dvec3 e2 = glm::cross(axis, e1);
+    const glm::dvec3 rel = q - p_.hair_crown;
+    const double azimuth = std::atan2(glm::dot(rel, e2), glm::dot(rel, e1));
+    // Across in mm at a typical distance; fanning out with distance is the whorl.
+    const double across = azimuth * 70.0;
+    const double w = p_.hair_strand_width, len = p_.hair_strand_length;
+    // Clumps: each a band across, with its own phase along, so its tips
+    // (lighter, thinner) fall in different places.
+    const double clump_w = 4.0 * w;
+    const double cu = across / clump_w;
+    const int ci = static_cast<int>(std::floor(cu));
+    const double phase = hash(ci, 7, 3);
+    const double tip = std::fmod(along / len + phase + 100.0, 1.0);
+    const double strands = 0.45 * noise(across / w, along / (0.35 * len), 1.0) +
+                           0.35 * noise(across / (0.5 * w), along / (0.25 * len), 2.0) +
+                           0.2 * noise(across / (2.3 * w), along / len, 3.0);
+    const double clump_edge = std::abs(cu - ci - 0.5) * 2.0;  // 0 mid-clump .. 1 between clumps
+    double value = 0.85 + 0.9 * (strands - 0.5) - 0.3 * clump_edge * clump_edge;
+    value *= 1.0 + p_.hair_tip_lightening * glm::smoothstep(0.4, 1.0, tip);
+    value *= 0.9 + 0.2 * noise(q.x * 0.05, q.y * 0.05, q.z * 0.05 + 9.0);
+    *colour = from255(p_.hair) * std::max(value, 0.15);
+
+    // The hairline: hair thins over the band, the strands parting so that
+    // single fine ones reach into it.
+    const double density = glm::smoothstep(-0.4 * band, 0.6 * band, edge);
+    if (density >= 1.0) return 1.0;
+    const double fine = noise(across / (0.6 * w), along / (0.5 * len), 4.0);
+    const double strand = glm::smoothstep(0.42, 0.62, fine);
+    // Baby hairs are finer and lighter.
+    *colour = blend(*colour, *colour * 1.15, 1.0 - density);
+    return std::clamp(density * mix(strand, 1.0, density), 0.0, 1.0);
 }
 
 // Redness: haemoglobin absorbs green and blue, so a redder patch keeps its
 // red and loses some of both. `amount` 1 is the strongest flush painted.
 Rgb redden(Rgb c, double amount) {
-    return blend(c, c * Rgb{1.02, 0.83, 0.85}, std::clamp(amount, 0.0, 1.5));
+    return blend(c, c * Rgb{1.02, 0.83, 0.85}, std::clamp(amount, -0.5, 1.5));
 }
 // A soft elliptical field, 1 at (cx, cy) falling off as a Gaussian of
 // widths sx, sy (mm): regions of colour with no edge to see.
@@ -130,80 +299,142 @@ double field(double x, double y, double cx, double cy, double sx, double sy) {
     const double dx = (x - cx) / sx, dy = (y - cy) / sy;
     return std::exp(-0.5 * (dx * dx + dy * dy));
 }
+Rgb tint(Rgb c, const glm::dvec3& t, double amount) { return blend(c, c * Rgb{t[0], t[1], t[2]}, amount); }
 
-Rgb Painter::skin(glm::dvec3 q) const {
+Texel Painter::skin(glm::dvec3 q) const {
+    const FaceParams::Albedo& al = p_.albedo;
     const Rgb skin = from255(p_.skin);
+    double gloss = 1.0;
     // Gentle pigment variation at two scales (MATTS: even skin reads young,
     // so it stays within a few percent), and haemoglobin mottling apart from
     // it so the two do not move together.
-    Rgb c = skin * (0.96 + 0.08 * fbm(q.x * 0.08, q.y * 0.08, q.z * 0.08));
-    c = redden(c, 0.35 * (fbm(q.x * 0.21 + 11.0, q.y * 0.21, q.z * 0.21) - 0.45));
+    Rgb c = skin * (1.0 - al.pigment_variation * 0.5 + al.pigment_variation * fbm(q.x * 0.08, q.y * 0.08, q.z * 0.08));
+    c = redden(c, al.mottling * (fbm(q.x * 0.21 + 11.0, q.y * 0.21, q.z * 0.21) - 0.45));
     const double ax = std::abs(q.x);
     const bool front = q.z > 45.0;
     if (front) {
-        // Regional redness (HAN, XIAO: the cheek is the reddest site; the
-        // nose and chin are flushed; the forehead is the darkest and least
-        // red). Broad Gaussian fields, their strength broken up by noise, so
-        // they read as blood under skin, not as painted discs.
-        const double blotch = 0.75 + 0.5 * noise(q.x * 0.15, q.y * 0.15, 4.0);
-        const double cheek = field(ax, q.y, 40.0, -26.0, 17.0, 15.0);
-        const double nose = field(q.x, q.y, 0.0, -36.0, 8.0, 9.0) + 0.5 * field(ax, q.y, 11.0, -41.0, 5.0, 5.0);
-        const double chin = field(q.x, q.y, 0.0, -96.0, 14.0, 9.0);
-        c = redden(c, blotch * (0.55 * cheek + 0.5 * nose + 0.22 * chin));
+        // Regional redness: broad fields whose strength is broken up by
+        // large noise and carried by a fine capillary texture.
+        const double breakup = 1.0 - al.flush_breakup + 2.0 * al.flush_breakup * noise(q.x * 0.07, q.y * 0.07, 4.0);
+        const double capillaries = 0.75 + 0.5 * fbm(q.x * 0.9, q.y * 0.9, 6.0);
+        double flush = 0.0;
+        for (const auto& f : al.flush)
+            flush += f.amount * field(f.centre[0] == 0.0 ? q.x : ax, q.y, f.centre[0], f.centre[1], f.size[0], f.size[1]);
+        c = redden(c, flush * breakup * capillaries);
         // Forehead: a shade darker and more yellow.
-        const double forehead = glm::smoothstep(18.0, 45.0, q.y);
-        c = blend(c, c * Rgb{0.97, 0.955, 0.92}, 0.8 * forehead);
+        c = tint(c, al.forehead_tint, al.forehead_amount * glm::smoothstep(18.0, 45.0, q.y));
+        // Freckles: one candidate per cell of a jittered grid, over the nose
+        // and cheeks mostly.
+        {
+            const double sp = al.freckle_spacing;
+            const int fx = static_cast<int>(std::floor(q.x / sp)), fy = static_cast<int>(std::floor(q.y / sp));
+            double spot = 0.0;
+            for (int dj = -1; dj <= 1; ++dj)
+                for (int di = -1; di <= 1; ++di) {
+                    const int i = fx + di, j = fy + dj;
+                    if (hash(i, j, 71) > 0.45) continue;
+                    const double px = (i + hash(i, j, 73)) * sp, py = (j + hash(i, j, 79)) * sp;
+                    const double r = al.freckle_size * (0.5 + hash(i, j, 83));
+                    spot = std::max(spot, (1.0 - glm::smoothstep(0.3 * r, r, std::hypot(q.x - px, q.y - py))) *
+                                              (0.4 + 0.6 * hash(i, j, 89)));
+                }
+            const double where = field(ax, q.y, 22.0, -30.0, 26.0, 16.0) + field(q.x, q.y, 0.0, -25.0, 10.0, 16.0);
+            c = blend(c, c * Rgb{0.86, 0.78, 0.72}, al.freckle_strength / 0.09 * 0.09 * 1.6 * spot * std::min(where, 1.0));
+        }
+        // Periorbital: thin skin, a warmer darker cast, deepest under the inner lower lid.
+        const double eye_x = p_.eye_centre[0], eye_y = p_.eye_centre[1];
+        const double orbit = field(ax, q.y, eye_x - 3.0, eye_y - 6.0, 11.0, 5.5) + 0.5 * field(ax, q.y, eye_x, eye_y + 3.0, 12.0, 6.0);
+        c = tint(c, al.periorbital_tint, al.periorbital_amount * std::min(orbit, 1.0));
 
-        // Beard zone (shaved): a bluish-grey cast from the stubble under the
-        // skin, over the upper lip, chin, jaw and lower cheeks, below a line
-        // from the sideburn to the mouth corner, fading on the neck.
+        // Beard zone (shaved): below a line from the sideburn to the mouth
+        // corner, fading on the neck.
         const double cheek_line = ax < 28.0 ? -46.0 : mix(-46.0, -14.0, std::min((ax - 28.0) / 34.0, 1.0));
         const double beard = glm::smoothstep(2.0, -10.0, q.y - cheek_line) * glm::smoothstep(-150.0, -118.0, q.y) *
                              (0.8 + 0.4 * noise(q.x * 1.7, q.y * 1.7, q.z * 1.7));
-        c = blend(c, c * Rgb{0.84, 0.88, 0.97}, 0.38 * beard);
+        c = tint(c, al.beard_tint, al.beard_amount * beard);
 
-        // Lips.
+        // T-zone: forehead centre and nose are oilier (glossier).
+        const double t_zone = std::max(field(q.x, q.y, 0.0, 40.0, 22.0, 18.0), field(q.x, q.y, 0.0, -20.0, 9.0, 24.0));
+        gloss = mix(1.0, p_.gloss.t_zone, std::min(t_zone, 1.0));
+
+        // Lips: the vermilion fades into the skin over the border's width,
+        // a little lighter just outside it (the white roll), with fine
+        // vertical lines.
         const double hw = s_.mouth_half_width();
-        if (ax < hw + 2.0 && q.z > 60.0) {
+        if (ax < hw + 4.0 && q.z > 60.0) {
             const double up = s_.upper_border(q.x), lo = s_.lower_border(q.x);
             const double inside = std::min({up - q.y, q.y - lo, (hw - ax) * 0.6});
-            const double m = glm::smoothstep(-0.3, 0.35, inside);
+            const double border = al.lip_border_mm;
+            const double m = glm::smoothstep(-0.45 * border, 0.55 * border, inside);
+            const double roll = (1.0 - glm::smoothstep(0.0, 1.2, std::abs(inside + 0.6 * border))) *
+                                (q.y > s_.mouth_line(q.x) ? 1.0 : 0.4);
+            c = blend(c, c * 1.06, 0.5 * roll * (1.0 - m));
             if (m > 0) {
                 const double crease = glm::smoothstep(0.0, 2.0, std::abs(q.y - s_.mouth_line(q.x)));
-                Rgb lips = from255(p_.lips) * (0.78 + 0.22 * crease) *
-                           (0.94 + 0.12 * noise(q.x * 2.5, q.y * 0.6, 1.0));
+                // Lines run across the lip (vertically), meandering; deepest mid-lip.
+                const double lx = q.x * 1.25 + 0.6 * std::sin(q.y * 0.9 + q.x * 0.2);
+                const double groove = std::pow(std::abs(std::sin(kPi * lx)), 6.0) * (0.5 + noise(q.x * 0.8, q.y * 0.3, 2.0));
+                const double mid = glm::smoothstep(0.2, 1.5, inside) * (0.4 + 0.6 * crease);
+                Rgb lips = from255(p_.lips) * (0.84 + 0.16 * crease) * (0.95 + 0.1 * noise(q.x * 2.5, q.y * 0.6, 1.0));
+                lips = lips * (1.0 - al.lip_lines * 0.35 * groove * mid);
                 c = blend(c, lips, m);
+                gloss = mix(gloss, p_.gloss.lips, m);
             }
         }
-        // Eyelids: lash lines and slightly darker lids.
+        // Eyelids: lash roots and slightly darker lids; the lid margin's
+        // strip and the tear meniscus where the lid meets the eyeball.
         const EyeOpening& e = s_.eye;
-        if (ax > e.x_in - 4 && ax < e.x_out + 5 && q.y > -15 && q.y < 20) {
+        if (ax > e.x_in - 8 && ax < e.x_out + 10 && q.y > -18 && q.y < 22) {
             const double s = clamp01(e.s(ax));
             const bool within = ax >= e.x_in && ax <= e.x_out;
             const double up = within ? e.upper(ax) : (ax < e.x_in ? e.y_in : e.y_out);
             const double lo = within ? e.lower(ax) : (ax < e.x_in ? e.y_in : e.y_out);
             const double dy_up = q.y - up, dy_lo = lo - q.y;
-            if (dy_up > -0.3) {
-                const double lid = (1.0 - glm::smoothstep(0.0, 9.0, dy_up)) * (within ? 1.0 : 0.5);
-                c = blend(c, c * Rgb{0.86, 0.78, 0.8}, 0.5 * lid);
-                const double reach = 0.6 + 0.9 * s;  // lashes thicken towards the outer corner
-                const double lash = (1.0 - glm::smoothstep(0.15, reach, dy_up)) * (within ? 1.0 : glm::smoothstep(3.0, 0.0, std::min(std::abs(ax - e.x_in), std::abs(ax - e.x_out))));
-                c = blend(c, Rgb{0.09, 0.06, 0.05}, 0.92 * lash);
+            // Fade out past the corners instead of stopping at a box.
+            const double past = ax < e.x_in ? e.x_in - ax : ax > e.x_out ? ax - e.x_out : 0.0;
+            const double along = 1.0 - glm::smoothstep(0.0, ax < e.x_in ? 3.0 : 6.0, past);
+            // How deep the point lies towards the eyeball: 0 on the lid's
+            // front skin, 1 on the eyeball side of the margin.
+            const glm::dvec3 centre{p_.eye_centre[0] * (q.x >= 0 ? 1.0 : -1.0), p_.eye_centre[1], p_.eye_centre[2]};
+            const double shell = glm::length(q - centre) - p_.eye_radius;
+            const double margin = 1.0 - glm::smoothstep(p_.lid_clearance + 0.35 * p_.lid_thickness,
+                                                        p_.lid_clearance + 0.95 * p_.lid_thickness, shell);
+            if (dy_up > -1.0) {
+                const double lid = (1.0 - glm::smoothstep(0.0, 9.0, dy_up)) * along;
+                c = tint(c, {0.88, 0.8, 0.8}, 0.45 * lid);
+                const double reach = 0.5 + 0.6 * s;  // lash roots thicken towards the outer corner
+                const double lash = (1.0 - glm::smoothstep(0.1, reach, std::abs(dy_up))) * along * (1.0 - margin);
+                c = blend(c, from255(p_.lashes), 0.6 * lash);
             }
-            if (dy_lo > -0.3 && within) {
-                const double lash = 1.0 - glm::smoothstep(0.05, 0.55, dy_lo);
-                c = blend(c, Rgb{0.25, 0.15, 0.13}, 0.55 * lash);
-                const double shadow = 1.0 - glm::smoothstep(0.0, 6.0, dy_lo);
-                c = blend(c, c * Rgb{0.88, 0.8, 0.82}, 0.35 * shadow);
+            if (dy_lo > -1.0) {
+                const double lash = (1.0 - glm::smoothstep(0.05, 0.45, std::abs(dy_lo))) * along * (1.0 - margin);
+                c = blend(c, Rgb{0.3, 0.19, 0.17}, 0.35 * lash);
+                const double shadow = (1.0 - glm::smoothstep(0.0, 6.0, dy_lo)) * along;
+                c = tint(c, {0.9, 0.83, 0.84}, 0.3 * shadow);
             }
-            // Inner corner (caruncle).
-            const double car = 1.0 - glm::smoothstep(0.6, 2.2, std::hypot(ax - e.x_in - 0.6, q.y - e.y_in));
-            c = blend(c, Rgb{0.78, 0.45, 0.45}, 0.7 * car);
+            const double near_slit = 1.0 - glm::smoothstep(1.0, 2.5, std::min(std::abs(dy_up), std::abs(dy_lo)));
+            const double strip = margin * near_slit * (within ? 1.0 : along);
+            if (strip > 0.0) {
+                c = blend(c, from255(al.lid_margin), 0.85 * strip);
+                gloss = mix(gloss, p_.gloss.lid_margin, strip);
+                // The tear meniscus: along the lower margin where it meets the eyeball.
+                const double tear = (1.0 - glm::smoothstep(p_.lid_clearance + 0.1, p_.lid_clearance + 0.6, shell)) *
+                                    (dy_lo > -1.5 && q.y < e.slit(ax) ? 1.0 : 0.0) * along;
+                gloss = mix(gloss, p_.gloss.tear_line, tear);
+                // The caruncle in the inner corner, on the deep part only.
+                const double car = (1.0 - glm::smoothstep(0.6, 2.2, std::hypot(ax - e.x_in - 0.6, q.y - e.y_in)));
+                c = blend(c, Rgb{0.8, 0.5, 0.48}, 0.6 * car * strip);
+                gloss = mix(gloss, p_.gloss.tear_line, car * strip);
+            }
         }
-        // Brows.
+        // Brows: individual hairs over a faint shadow of the fine ones.
         if (q.y > 0 && q.y < 40 && ax < 65) {
-            const double d = brow_density(q.x, q.y);
-            if (d > 0) c = blend(c, from255(p_.brows) * (0.85 + 0.3 * noise(q.x * 4, q.y * 4, 9)), 0.93 * d);
+            const BrowPlace b = brow_place(q.x, q.y);
+            const double d = brow_density(b);
+            if (d > 0) c = blend(c, c * Rgb{0.8, 0.76, 0.74}, 0.35 * d);
+            Rgb hc;
+            const double cover = brow_hairs(q.x, q.y, &hc);
+            if (cover > 0) c = blend(c, hc, cover);
         }
         // Nostrils.
         const double n = s_.nostril_amount(q.x, q.y);
@@ -211,14 +442,14 @@ Rgb Painter::skin(glm::dvec3 q) const {
     }
     // Ears: thin, well perfused, redder than the face beside them.
     if (ax > 55.0 && s_.ear_relief(q.y, q.z) > 0.0)
-        c = redden(c, 0.45 * std::min(1.0, s_.ear_relief(q.y, q.z) / 3.0));
-    double h = 0;
-    if (hair(q, &h)) {
-        const Rgb hc = from255(p_.hair) *
-                       (0.8 + 0.4 * noise(q.x * 0.5, q.y * 2.5, q.z * 0.5)) * (0.9 + 0.2 * noise(q.x * 3, q.y * 3, q.z * 3));
+        c = redden(c, al.ear_flush * std::min(1.0, s_.ear_relief(q.y, q.z) / 3.0));
+    Rgb hc;
+    const double h = hair(q, &hc);
+    if (h > 0) {
         c = blend(c, hc, h);
+        gloss = mix(gloss, 1.0, h);
     }
-    return c;
+    return {c, gloss};
 }
 
 Rgb Painter::tile(double u, double v) const {
@@ -265,13 +496,13 @@ Image paint_base_colour(const FaceShape& shape, const TriMesh& mesh, int size) {
     img.rgba.assign(static_cast<std::size_t>(size) * size * 4, 0);
     std::vector<std::uint8_t> filled(static_cast<std::size_t>(size) * size, 0);
     Painter painter(shape);
-    auto put = [&](int x, int y, Rgb c) {
+    auto put = [&](int x, int y, Rgb c, double gloss) {
         const std::size_t i = static_cast<std::size_t>(y) * size + x;
         auto to8 = [](double v) { return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0)); };
         img.rgba[i * 4 + 0] = to8(c.r);
         img.rgba[i * 4 + 1] = to8(c.g);
         img.rgba[i * 4 + 2] = to8(c.b);
-        img.rgba[i * 4 + 3] = 255;
+        img.rgba[i * 4 + 3] = to8(gloss);
         filled[i] = 1;
     };
 
@@ -303,9 +534,10 @@ Image paint_base_colour(const FaceShape& shape, const TriMesh& mesh, int size) {
                 constexpr double kEps = -1e-4;
                 if (w0 < kEps || w1 < kEps || w2 < kEps) continue;
                 if (is_skin) {
-                    put(x, y, painter.skin(pos[0] * w0 + pos[1] * w1 + pos[2] * w2));
+                    const Texel t = painter.skin(pos[0] * w0 + pos[1] * w1 + pos[2] * w2);
+                    put(x, y, t.colour, t.gloss);
                 } else {
-                    put(x, y, painter.tile((x + 0.5) / size, 1.0 - (y + 0.5) / size));
+                    put(x, y, painter.tile((x + 0.5) / size, 1.0 - (y + 0.5) / size), 1.0);
                 }
             }
         }
@@ -318,19 +550,18 @@ Image paint_base_colour(const FaceShape& shape, const TriMesh& mesh, int size) {
             for (int x = 0; x < size; ++x) {
                 const std::size_t i = static_cast<std::size_t>(y) * size + x;
                 if (filled[i]) continue;
-                int sum[3] = {0, 0, 0}, n = 0;
+                int sum[4] = {0, 0, 0, 0}, n = 0;
                 for (int dy = -1; dy <= 1; ++dy)
                     for (int dx = -1; dx <= 1; ++dx) {
                         const int xx = x + dx, yy = y + dy;
                         if (xx < 0 || yy < 0 || xx >= size || yy >= size) continue;
                         const std::size_t j = static_cast<std::size_t>(yy) * size + xx;
                         if (!filled[j]) continue;
-                        for (int c = 0; c < 3; ++c) sum[c] += img.rgba[j * 4 + c];
+                        for (int c = 0; c < 4; ++c) sum[c] += img.rgba[j * 4 + c];
                         ++n;
                     }
                 if (n == 0) continue;
-                for (int c = 0; c < 3; ++c) img.rgba[i * 4 + c] = static_cast<std::uint8_t>(sum[c] / n);
-                img.rgba[i * 4 + 3] = 255;
+                for (int c = 0; c < 4; ++c) img.rgba[i * 4 + c] = static_cast<std::uint8_t>(sum[c] / n);
                 next[i] = 1;
             }
         }

@@ -2,7 +2,14 @@
 // Paints the default face's base-colour image by rasterising every triangle
 // in texture space and colouring each texel from the neutral 3D position it
 // covers (skin, lips, brows, lashes, hair, nostrils) or from its place in a
-// part's tile (eyeball, mouth cavity, teeth, tongue).
+// part's tile (eyeball, mouth cavity, teeth, tongue). Hair, brow hairs and
+// lip lines are painted at the neutral position they cover, so they travel
+// with the skin (its UVs) when it moves.
+//
+// Alpha is not coverage: it is the region's roughness scale for the skin
+// shading model (render/skin_shading.h; face.json albedo.roughness): 1 on
+// most skin and on the tiles, lower on the T-zone, lips, lid margins and the
+// tear meniscus.
 #include <vector>
 
 #include "emoface/expression/face.h"

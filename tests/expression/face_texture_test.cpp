@@ -1,0 +1,234 @@
+// The default face's painted base colour (expression/src/face_texture.cpp):
+// brows as hairs that travel with the brow, a soft hairline, cheeks without
+// painted discs, and per-region roughness in the alpha channel. Texels are
+// found through the mesh's own UVs from the neutral 3D positions face.json
+// describes (mm).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <vector>
+
+#include "emoface/expression/default_face.h"
+#include "emoface/expression/rig.h"
+#include "emoface/fap/feature_points.h"
+#include "test_face.h"
+
+namespace emoface::expression {
+namespace {
+
+constexpr int kSize = 1024;
+
+// A face with a texture fine enough to hold hairs (the shared test face's
+// 64 texels cannot); half the mesh resolution keeps it quick.
+const Face& painted_face() {
+    static const Face face = [] {
+        DefaultFaceOptions options;
+        options.resolution_scale = 0.5;
+        options.texture_size = kSize;
+        return make_default_face(testing::data_dir() + "/face", options);
+    }();
+    return face;
+}
+
+struct Texel {
+    double r, g, b, a;  // 0..1
+    double luminance() const { return 0.2126 * r + 0.7152 * g + 0.0722 * b; }
+};
+
+Texel texel_at(double u, double v) {
+    const Image& img = painted_face().base_colour;
+    const int x = std::clamp(static_cast<int>(u * img.width), 0, img.width - 1);
+    const int y = std::clamp(static_cast<int>((1.0 - v) * img.height), 0, img.height - 1);
+    const std::uint8_t* p = &img.rgba[(static_cast<std::size_t>(y) * img.width + x) * 4];
+    return {p[0] / 255.0, p[1] / 255.0, p[2] / 255.0, p[3] / 255.0};
+}
+Texel texel_of(int vertex) {
+    const auto t = painted_face().mesh.texcoord2D(TriMesh::VertexHandle(vertex));
+    return texel_at(t[0], t[1]);
+}
+
+// The front-facing skin vertex nearest (x, y) in frontal projection.
+int front_vertex(double x, double y) {
+    const Face& f = painted_face();
+    int best = -1;
+    double best_d = 1e18;
+    for (int v = 0; v < f.vertex_count(); ++v) {
+        if (f.parts[v] != VertexPart::Skin) continue;
+        const auto p = f.mesh.point(TriMesh::VertexHandle(v));
+        const auto n = f.mesh.normal(TriMesh::VertexHandle(v));
+        if (n[2] < 0.3) continue;
+        const double d = (p[0] - x) * (p[0] - x) + (p[1] - y) * (p[1] - y);
+        if (d < best_d) {
+            best_d = d;
+            best = v;
+        }
+    }
+    return best;
+}
+
+// Luminance along the straight UV path between the vertices nearest two
+// frontal points, `steps` + 1 samples.
+std::vector<double> luminance_between(double x, double y0, double y1, int steps) {
+    const Face& f = painted_face();
+    const auto a = f.mesh.texcoord2D(TriMesh::VertexHandle(front_vertex(x, y0)));
+    const auto b = f.mesh.texcoord2D(TriMesh::VertexHandle(front_vertex(x, y1)));
+    std::vector<double> out;
+    for (int k = 0; k <= steps; ++k) {
+        const double t = static_cast<double>(k) / steps;
+        out.push_back(texel_at(a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t).luminance());
+    }
+    return out;
+}
+
+// Brow hairs travel with the brow: the texels that are brow hair belong to
+// vertices the brow raise lifts, so after the raise the hair-dark vertices
+// have moved up by about as much as the brow's feature points (a brow painted
+// in a fixed frontal projection would stay put and smear).
+TEST(FaceTexture, BrowHairsMoveWithTheRaisedBrow) {
+    const Face& f = painted_face();
+    const FaceRig rig(f);
+    FapValues faps{};
+    for (int fap = 31; fap <= 36; ++fap) faps[fap - 1] = 300;  // raise inner, middle, outer brows
+    const DeformedFace raised = rig.deform(faps);
+    const double skin = texel_of(front_vertex(0, 40)).luminance();
+    double brow_rise = 0.0;
+    for (const char* id : {"4.1", "4.2", "4.3", "4.4", "4.5", "4.6"}) {
+        const int k = fap::feature_point_index(id);
+        brow_rise += (raised.feature_points[k][1] - f.feature_points[k].position[1]) / 6.0;
+    }
+    ASSERT_GT(brow_rise, 2.0) << "the brow raise lifts the brows";
+    double rise = 0.0;
+    int dark = 0;
+    for (int v = 0; v < f.vertex_count(); ++v) {
+        const auto p = f.mesh.point(TriMesh::VertexHandle(v));
+        if (f.parts[v] != VertexPart::Skin || p[2] < 40 || p[1] < 5 || p[1] > 35 || std::abs(p[0]) > 60) continue;
+        if (texel_of(v).luminance() > 0.5 * skin) continue;
+        rise += raised.positions[v][1] - p[1];
+        ++dark;
+
+    }
+    ASSERT_GT(dark, 20) << "brow hair vertices";
+    EXPECT_GT(rise / dark, 0.6 * brow_rise);
+}
+
+// Brow hairs have a direction: the inner end's hairs grow upward, the
+// outer part's run along the brow. The strokes' orientation (the structure
+// tensor of the texture's luminance) is more vertical at the inner end.
+TEST(FaceTexture, InnerBrowHairsStandUpAndOuterOnesLieAlong) {
+    const Face& f = painted_face();
+    const Image& img = f.base_colour;
+    auto luminance = [&](int x, int y) {
+        const std::uint8_t* p = &img.rgba[(static_cast<std::size_t>(y) * img.width + x) * 4];
+        return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+    };
+    // Share of the gradient energy along the texture's columns (v): strokes
+    // that run up and down have their gradients across, along u.
+    auto vertical_gradient_share = [&](double x, double y) {
+        const auto t = f.mesh.texcoord2D(TriMesh::VertexHandle(front_vertex(x, y)));
+        const int cx = static_cast<int>(t[0] * img.width), cy = static_cast<int>((1.0 - t[1]) * img.height);
+        double gxx = 0, gyy = 0;
+        for (int y2 = cy - 5; y2 <= cy + 5; ++y2)
+            for (int x2 = cx - 5; x2 <= cx + 5; ++x2) {
+                const double gx = luminance(x2 + 1, y2) - luminance(x2 - 1, y2);
+                const double gy = luminance(x2, y2 + 1) - luminance(x2, y2 - 1);
+                gxx += gx * gx;
+                gyy += gy * gy;
+            }
+        return gyy / (gxx + gyy + 1e-9);
+    };
+    const auto& inner = f.feature_points[fap::feature_point_index("4.1")].position;
+    const auto& outer = f.feature_points[fap::feature_point_index("4.5")].position;
+    // A little inside each end, where the hairs are dense.
+    const double inner_share = vertical_gradient_share(inner[0] + 3.0, inner[1]);
+    const double outer_share = vertical_gradient_share(outer[0] - 8.0, outer[1] + 1.0);
+    EXPECT_LT(inner_share, 0.45) << "inner hairs stand up: their gradients run across the texture";
+    EXPECT_GT(outer_share, 0.55) << "outer hairs lie along the brow: their gradients run up and down";
+}
+
+// The hairline is a band, not a cut: from the forehead up into the hair, the
+// luminance falls over several millimetres, and its height changes little
+// from one column to the next (no saw-tooth).
+TEST(FaceTexture, HairlineIsASoftSmoothBand) {
+    constexpr double kFrom = 62.0, kTo = 92.0;  // mm; face.json hairline_y 76
+    constexpr int kSteps = 300;                 // 0.1 mm a step
+    std::vector<double> crossing;
+    for (double x = -16.0; x <= 16.0; x += 2.0) {
+        std::vector<double> l = luminance_between(x, kFrom, kTo, kSteps);
+        // Smooth over 2 mm so single hairs do not decide the edge.
+        std::vector<double> s(l.size());
+        for (std::size_t k = 0; k < l.size(); ++k) {
+            double sum = 0;
+            int n = 0;
+            for (int d = -10; d <= 10; ++d) {
+                const int j = static_cast<int>(k) + d;
+                if (j < 0 || j >= static_cast<int>(l.size())) continue;
+                sum += l[static_cast<std::size_t>(j)];
+                ++n;
+            }
+            s[k] = sum / n;
+        }
+        const double skin = s.front(), hair = s.back();
+        ASSERT_GT(skin, 2.0 * hair) << "forehead skin below, hair above at x = " << x;
+        auto first_below = [&](double level) {
+            for (std::size_t k = 0; k < s.size(); ++k)
+                if (s[k] < level) return static_cast<double>(k) * (kTo - kFrom) / kSteps;
+            return kTo - kFrom;
+        };
+        const double start = first_below(hair + 0.9 * (skin - hair));
+        const double end = first_below(hair + 0.1 * (skin - hair));
+        EXPECT_GT(end - start, 3.0) << "mm from 90% skin to 10% at x = " << x;
+        crossing.push_back(first_below(hair + 0.5 * (skin - hair)));
+    }
+    for (std::size_t k = 1; k < crossing.size(); ++k)
+        EXPECT_LT(std::abs(crossing[k] - crossing[k - 1]), 2.0) << "hairline jumps between columns " << k - 1 << " and " << k;
+}
+
+// Cheeks are redder than the forehead, but diffusely: the redness excess at
+// the cheek's centre over the ring 25 mm around it is small (a 15 mm
+// painted disc of blush gave about 0.06 in g/r).
+TEST(FaceTexture, CheekRednessIsDiffuseNotADisc) {
+    const Face& f = painted_face();
+    auto green_over_red = [&](double cx, double cy, double r0, double r1) {
+        double sum = 0;
+        int n = 0;
+        for (int v = 0; v < f.vertex_count(); ++v) {
+            if (f.parts[v] != VertexPart::Skin) continue;
+            const auto p = f.mesh.point(TriMesh::VertexHandle(v));
+            if (f.mesh.normal(TriMesh::VertexHandle(v))[2] < 0.3) continue;
+            const double d = std::hypot(std::abs(p[0]) - cx, p[1] - cy);
+            if (d < r0 || d > r1) continue;
+            const Texel t = texel_of(v);
+            sum += t.g / t.r;
+            ++n;
+        }
+        EXPECT_GT(n, 4);
+        return sum / std::max(n, 1);
+    };
+    const double centre = green_over_red(38, -30, 0, 4);
+    const double ring = green_over_red(38, -30, 23, 27);
+    const double forehead = green_over_red(20, 45, 0, 6);
+    EXPECT_LT(centre, forehead - 0.01) << "cheeks redder than the forehead";
+    EXPECT_LT(ring - centre, 0.035) << "no disc of blush";
+}
+
+// Alpha is the region's roughness scale: lips and the nose (T-zone) are
+// glossier than the cheek, the hair and cheek are 1.
+TEST(FaceTexture, AlphaHoldsTheRegionsRoughness) {
+    const Face& f = painted_face();
+    const auto lip_uv = (f.mesh.texcoord2D(TriMesh::VertexHandle(f.feature_points[fap::feature_point_index("2.3")].vertex)) +
+                         f.mesh.texcoord2D(TriMesh::VertexHandle(f.feature_points[fap::feature_point_index("8.2")].vertex))) *
+                        0.5f;
+    const double lips = texel_at(lip_uv[0], lip_uv[1]).a;
+    const double cheek = texel_of(front_vertex(45, -35)).a;
+    const double nose = texel_of(front_vertex(0, -25)).a;
+    const double crown = texel_of(f.feature_points[fap::feature_point_index("11.4")].vertex).a;
+    EXPECT_NEAR(cheek, 1.0, 0.02);
+    EXPECT_NEAR(crown, 1.0, 0.02);
+    EXPECT_LT(lips, cheek - 0.1);
+    EXPECT_LT(nose, cheek - 0.05);
+}
+
+}  // namespace
+}  // namespace emoface::expression
