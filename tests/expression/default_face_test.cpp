@@ -74,6 +74,41 @@ TEST(DefaultFace, HasAll84FeaturePointsMirroredLeftToRight) {
     EXPECT_NE(f.feature_points[fp("2.2")].vertex, f.feature_points[fp("2.3")].vertex);
 }
 
+// Adult anthropometric norms (shared/reference/FIDELITY.md 4): the head
+// must not read as a mannequin's long face on a tube.
+TEST(DefaultFace, HeadIsInAdultProportions) {
+    const Face& f = test_face();
+    auto at = [&](const char* id) { return f.position(fp(id)); };
+    // Widest skin at a height (in front of z_min), left side.
+    auto width_at = [&](double y, double z_min) {
+        double w = 0;
+        for (int v = 0; v < f.vertex_count(); ++v) {
+            if (f.parts[v] != VertexPart::Skin) continue;
+            const auto q = f.mesh.point(TriMesh::VertexHandle(v));
+            if (std::abs(q[1] - y) < 2.0 && q[2] > z_min) w = std::max(w, 2.0 * std::abs(q[0]));
+        }
+        return w;
+    };
+    // Face height (sellion, about the upper lid crease's height, to menton)
+    // to bizygomatic width: 0.85-0.86 on average (ANSUR); a long face is
+    // above 0.95.
+    const double sellion_y = at("3.1")[1] + 8.0;
+    const double face_height = sellion_y - at("2.1")[1];
+    const double bizygomatic = width_at(at("3.5")[1] - 18.0, 10.0);
+    EXPECT_GT(face_height / bizygomatic, 0.75);
+    EXPECT_LT(face_height / bizygomatic, 0.95);
+    // Mouth corners under the irises' medial halves.
+    const double iris_radius = f.eyeballs[0].radius * std::sin(f.eyeballs[0].iris_angle);
+    EXPECT_GT(at("2.4")[0], at("3.5")[0] - iris_radius - 1.5);
+    EXPECT_LT(at("2.4")[0], at("3.5")[0]);
+    // Ears: top near the brow, lobe near the nose base, set behind the face.
+    EXPECT_NEAR(at("10.1")[1], at("4.3")[1], 12.0);
+    EXPECT_NEAR(at("10.5")[1], at("9.15")[1], 10.0);
+    EXPECT_LT(at("10.1")[2], at("10.9")[2]);  // tilted back: the top behind the front contact
+    // The neck below the chin is narrower than the jaw at its angles.
+    EXPECT_LT(width_at(at("2.1")[1] - 25.0, -200.0), 2.0 * at("2.13")[0]);
+}
+
 TEST(DefaultFace, FullResolutionHasSeveralThousandVertices) {
     DefaultFaceOptions options;
     options.texture_size = 16;
