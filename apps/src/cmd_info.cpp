@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "au_label.h"
+#include "clamp_warning.h"
 #include "command.h"
 #include "emoface/common/error.h"
 #include "emoface/expression/face_state.h"
@@ -236,6 +237,8 @@ void add_info_command(CLI::App& root) {
                     throw emoface::InputError(fmt::format("info: {}: --frame {} is past its {} frames", path, *frame,
                                                           s.frames.size()));
                 const auto aus = action_units_of(s, profiles, *frame);
+                // What play would clamp, on stderr so that --json stays clean.
+                emoface::apps::warn_clamped_faps("info", path, s, *data);
                 const std::string which = *frame >= 0 ? fmt::format("frame {}", *frame) : "peak";
                 if (*json) {
                     nlohmann::json j = to_json(path, s);

@@ -16,6 +16,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "au_label.h"
+#include "clamp_warning.h"
 #include "command.h"
 #include "emoface/common/error.h"
 #include "emoface/expression/emotion.h"
@@ -107,6 +108,7 @@ void run_inspect(const InspectArgs& a) {
         output.emplace(a.out, "inspect");
     }
 
+    if (stream && so.clamp_faps) warn_clamped_faps("inspect", a.fap, *stream, so.data);
     Session session(so);
 
     View view;
@@ -192,6 +194,7 @@ void add_inspect_command(CLI::App& root) {
     sub->add_flag("--no-labels", a->no_labels, "Dots and lines only");
     sub->add_option("--keys", a->keys, "Window: press these keys first (e.g. \"dDsq\"; for scripts and tests)");
     add_session_options(*sub, a->session);
+    add_clamp_option(*sub, a->session);
     sub->callback([a, out] {
         a->out_given = out->count() > 0;
         run_inspect(*a);

@@ -12,6 +12,7 @@
 
 #include <fmt/format.h>
 
+#include "clamp_warning.h"
 #include "command.h"
 #include "emoface/common/error.h"
 #include "emoface/common/output_batch.h"
@@ -161,6 +162,8 @@ void run_play(const PlayArgs& a) {
     // if the command fails) and proves it can be written.
     OutputBatch batch(folder, what);
     const fap::FapStream resolved = fap::resolve_untransmitted(stream);
+    // Once, before the slow part; the rig clamps each frame as it plays.
+    if (so.clamp_faps) warn_clamped_faps("play", a.fap, resolved, so.data);
 
     Session session(so);
 
@@ -217,6 +220,7 @@ void add_play_command(CLI::App& root) {
                     "together make 0:107); frame patterns are numbered by frame");
     add_session_options(*sub, a->session);
     add_side_by_side_option(*sub, a->session);
+    add_clamp_option(*sub, a->session);
     add_viewer_options(*sub, a->viewer, out);
     sub->callback([a, fps, frames] {
         a->fps_given = fps->count() > 0;

@@ -30,6 +30,7 @@ void add_view_command(CLI::App& root) {
     sub->add_option("--mix", args->viewer.mix, "Emotion mix the sliders start at, e.g. \"0.7 anger + 0.3 fear\"");
     sub->add_option("--size", args->size, "Window size WIDTHxHEIGHT")->capture_default_str();
     apps::add_session_options(*sub, args->session);
+    apps::add_clamp_option(*sub, args->session);
     apps::add_viewer_options(*sub, args->viewer);
     sub->callback([args] {
         apps::ViewerOptions o = args->viewer;

@@ -109,6 +109,7 @@ SessionOptions SessionArgs::resolve(const std::string& command, int width, int h
     else if (shading == "thesis") o.shading = render::Shading::Thesis;
     else fail<InputError>("{}: --shading '{}': expected skin or thesis", command, shading);
     o.wrinkles = !no_wrinkles;
+    o.clamp_faps = !no_clamp;
     o.width = width;
     o.height = height;
     render::check_wrinkle_map_size(o.wrinkle_size, command + ": --wrinkle-size");
@@ -150,6 +151,12 @@ CLI::Option* add_side_by_side_option(CLI::App& sub, SessionArgs& a) {
     return sub.add_flag("--side-by-side", a.options.side_by_side,
                         "Two pictures of each pose side by side: with the wrinkle maps (left) and without "
                         "(right); the output is twice as wide as --size");
+}
+
+void add_clamp_option(CLI::App& sub, SessionArgs& a) {
+    sub.add_flag("--no-clamp", a.no_clamp,
+                 "Play FAP values raw, beyond the face's range (data/expression/fap_ranges.json) too, "
+                 "instead of clamping them (the mesh may tear or fold)");
 }
 
 void require_display(const std::string& command, const std::string& what, const std::string& headless) {
@@ -217,6 +224,7 @@ Session::Session(const SessionOptions& options, render::Platform* window) : opti
     render::FaceAssetsOptions ao;
     ao.wrinkle_map_size = options_.wrinkle_size;
     ao.layout = options_.layout;
+    ao.clamp_faps = options_.clamp_faps;
     if (!options_.wrinkle_folder.empty())
         ao.read_keys = [folder = options_.wrinkle_folder](const std::vector<expression::FeatureLine>& lines) {
             return render::read_wrinkle_keys(folder, lines);

@@ -75,6 +75,9 @@ struct SessionOptions {
     std::string wrinkle_folder;
     double face_resolution = 1.0;
     int texture_size = 0;
+    // FAPs clamped to the face's range (data/expression/fap_ranges.json);
+    // false (--no-clamp) plays a file's values raw.
+    bool clamp_faps = true;
 };
 
 // The options every drawing command (play, mix, inspect, morph) and `view`
@@ -88,6 +91,7 @@ struct SessionArgs {
     std::string layout = "projective";
     std::string shading = "skin";
     bool no_wrinkles = false;
+    bool no_clamp = false;
     // Checks and resolves them (InputError starting `command: `); width and
     // height are the headless platform's.
     SessionOptions resolve(const std::string& command, int width, int height) const;
@@ -96,6 +100,8 @@ void add_session_options(CLI::App& command, SessionArgs& args);
 // --side-by-side (with | without wrinkles), for the commands that write
 // pictures; returned so a command can tie it to its --out.
 CLI::Option* add_side_by_side_option(CLI::App& command, SessionArgs& args);
+// --no-clamp, for the commands that play FAP files (play, inspect, view).
+void add_clamp_option(CLI::App& command, SessionArgs& args);
 
 // Wall-clock milliseconds of loading, once per session.
 struct LoadTimes {

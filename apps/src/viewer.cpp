@@ -9,6 +9,8 @@
 // that framebuffer, so it shows what the window showed.
 #include "viewer.h"
 
+#include "clamp_warning.h"
+
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -659,6 +661,7 @@ int run_viewer(const ViewerOptions& options) {
                                morph::cuda_device_description());
 
     auto window = open_window(options);
+    if (stream && so.clamp_faps) warn_clamped_faps(command, options.fap_path, *stream, so.data);
     auto gui = std::make_unique<ImGuiLayer>(window->window());
     draw_loading_frame(*window, *gui, "loading the face and its wrinkle maps ...");
 

@@ -67,7 +67,7 @@ std::unique_ptr<FaceAssets> load_face_assets(expression::Face face, const std::s
 
     auto t = Clock::now();
     expression::RigOptions rig_options;
-    rig_options.ranges = expression::load_fap_ranges(dir + "fap_ranges.json");
+    if (options.clamp_faps) rig_options.ranges = expression::load_fap_ranges(dir + "fap_ranges.json");
     a->rig = std::make_unique<expression::FaceRig>(a->face, rig_options);
     a->times.rig_ms = ms_since(t);
 

@@ -47,6 +47,9 @@ struct FaceAssetsOptions {
     int wrinkle_map_size = 1024;          // 256..4096 (generated keys)
     expression::DefaultFaceOptions face;  // the default face's resolution
     WrinkleLayout layout = WrinkleLayout::Projective;
+    // The rig clamps FAPs to the human ranges of expression/fap_ranges.json;
+    // false keeps them raw (--no-clamp).
+    bool clamp_faps = true;
     // Where the keys come from instead of being generated (painted maps): a
     // reader given the face's feature lines, e.g. render_io's
     // read_wrinkle_keys on a folder (render itself reads no image files).
