@@ -15,7 +15,11 @@
 //          (and its corner sums without them),
 //          then apply_kernel over the pixels: far sums interpolated, near
 //          lines exact (kernel.h, "fast mode"), texture-unit sampling
-//          (keys cropped to a region by hand: rest outside the crop).
+//          where the weights sum to at most 1 (else, and for keys cropped
+//          to a region, by hand: rest outside the crop).
+// A frame of K <= 8 sources without regions, the common case, runs kernels
+// specialised for one batch (warp_kernel, apply_kernel: One), as fast as
+// before batches existed.
 // Nothing is allocated per frame; buffers for positions, host output and the
 // fast grid are allocated at their first use.
 #include <cuda_runtime.h>
@@ -76,6 +80,7 @@ struct KernelArgs {
     float weight[kMaxKeys];
     kernel::Bound bound[kMaxKeys];          //   target pixels where evaluated
     kernel::Rgba rest;
+    int hw_filter;  // whole keys through the texture unit (sample_batch)
     int is_float;
     int normal_map;
     OutKind out_kind;
@@ -155,13 +160,19 @@ __device__ EMOFACE_INLINE float batch_weight(const KernelArgs& a, const kernel::
 // shared memory, so a 256² image still fills the GPU. The block lists the
 // sources whose bound meets its points and runs the lines once per batch
 // of them (kernel.h, "Batches"); the batches' colours add up per point.
-template <int K, int PX, Law L>
+// One: the frame's K sources are one batch evaluated everywhere (no
+// regions, K <= kMaxBatch), the common case: no source lists, each line
+// record loaded into registers with 16-byte loads at a compile-time size,
+// and each point blended and stored as soon as its sums are done (no
+// colour kept across batches).
+template <int K, int PX, Law L, bool One>
 __global__ void __launch_bounds__(256) warp_kernel(const __grid_constant__ KernelArgs a,
                                                    const __grid_constant__ LineTable table) {
     constexpr int S = kernel::sum_floats(K);
+    constexpr int kOneRec4 = kernel::record_floats(K) / 4;
     extern __shared__ float4 s_lines[];
     const float4* src = a.lines != nullptr ? a.lines : table.rec;
-    const int rec4 = a.record_floats / 4;
+    const int rec4 = One ? kOneRec4 : a.record_floats / 4;
     const int tid = threadIdx.y * blockDim.x + threadIdx.x;
     const int threads = blockDim.x * blockDim.y;
     const bool split = a.line_split > 1;
@@ -170,34 +181,32 @@ __global__ void __launch_bounds__(256) warp_kernel(const __grid_constant__ Kerne
     const int first_line = split ? threadIdx.y : 0;
     const int line_step = split ? blockDim.y : 1;
     const bool writes = !split || threadIdx.y == 0;
-
-    // The block's points in pixels, grown by one lattice step: a grid
-    // point serves the cells on both sides of it.
-    const int bi0 = blockIdx.x * blockDim.x * PX, bi1 = bi0 + blockDim.x * PX;
-    const int bj0 = split ? blockIdx.y : blockIdx.y * blockDim.y, bj1 = split ? bj0 + 1 : bj0 + blockDim.y;
     const int sp = a.spacing;
-    std::uint32_t mask = kernel::sources_meeting(a.bound, a.sources, (bi0 - 1) * sp, (bj0 - 1) * sp,
-                                                 (bi1 - 1) * sp + sp, (bj1 - 1) * sp + sp);
-
     const float x0 = (static_cast<float>(i0 * sp) + 0.5f) * a.inv_extent;
     const float y = (static_cast<float>(j * sp) + 0.5f) * a.inv_extent;
     const float step = static_cast<float>(sp) * a.inv_extent;
-    kernel::Rgba colour[PX];
-#pragma unroll
-    for (int p = 0; p < PX; ++p) colour[p] = {0.0f, 0.0f, 0.0f, 0.0f};
-    float weight_sum = 0.0f;
-    kernel::Batch<K> batch;
-    while (kernel::take_batch(mask, batch)) {  // the same batches for the whole block
-        Accum<K, PX> acc;
+
+    // The sums of all lines for the batch at this thread's points (split:
+    // complete in the threadIdx.y == 0 threads).
+    auto sum_lines = [&](const kernel::Batch<K>& batch, Accum<K, PX>& acc) {
         acc.clear();
         for (int base = 0; base < a.n_lines; base += a.chunk_lines) {
             const int count = min(a.chunk_lines, a.n_lines - base);
             __syncthreads();
             for (int t = tid; t < count * rec4; t += threads) s_lines[t] = src[base * rec4 + t];
             __syncthreads();
-            for (int l = first_line; l < count; l += line_step)
-                kernel::accumulate_line<K, PX, L>(reinterpret_cast<const float*>(s_lines + l * rec4), x0, y, step,
-                                                  a.b, batch, acc);
+            for (int l = first_line; l < count; l += line_step) {
+                if constexpr (One) {
+                    float4 r4[kOneRec4];
+#pragma unroll
+                    for (int q = 0; q < kOneRec4; ++q) r4[q] = s_lines[l * kOneRec4 + q];
+                    kernel::accumulate_line<K, PX, L>(reinterpret_cast<const float*>(r4), x0, y, step, a.b, batch,
+                                                      acc);
+                } else {
+                    kernel::accumulate_line<K, PX, L>(reinterpret_cast<const float*>(s_lines + l * rec4), x0, y,
+                                                      step, a.b, batch, acc);
+                }
+            }
         }
         if (split) {
             float* partial = reinterpret_cast<float*>(s_lines + a.chunk_lines * rec4);
@@ -213,31 +222,73 @@ __global__ void __launch_bounds__(256) warp_kernel(const __grid_constant__ Kerne
                     for (int p = 0; p < PX; ++p) kernel::add_sums(other + p * S, p, acc);
                 }
         }
+    };
+    // Point p's result for the batch: grid sums, displacements, or its
+    // sources sampled and added to `colour`.
+    auto batch_point = [&](const kernel::Batch<K>& batch, const Accum<K, PX>& acc, int p, int i,
+                           kernel::Rgba& colour) {
+        if (a.out_kind == OutKind::Sums) {
+            kernel::store_frame_sums(acc, p, batch,
+                                     a.sums + (static_cast<std::size_t>(j) * a.points_w + i) * sums_stride(a.sources));
+            return;
+        }
+        float dx[K], dy[K];
+        kernel::displacement(acc, p, a.extent, dx, dy);
+        if (a.out_kind == OutKind::Displacement) {
+            float2* d = a.disp + (static_cast<std::size_t>(j) * a.points_w + i) * a.sources;
+#pragma unroll
+            for (int k = 0; k < K; ++k)
+                if (k < batch.n) d[batch.slot[k]] = make_float2(dx[k], dy[k]);
+            return;
+        }
+        kernel::blend_batch<K>(a.key, a.weight, batch, static_cast<float>(i) + 0.5f, static_cast<float>(j) + 0.5f, dx,
+                               dy, colour);
+    };
+    const bool colours = a.out_kind != OutKind::Sums && a.out_kind != OutKind::Displacement;
+
+    if constexpr (One) {
+        const kernel::Batch<K> batch = kernel::all_sources<K>();
+        Accum<K, PX> acc;
+        sum_lines(batch, acc);
+        if (!writes || j >= a.points_h) return;
+        const float weight_sum = batch_weight(a, batch);
+#pragma unroll
+        for (int p = 0; p < PX; ++p) {
+            const int i = i0 + p;
+            if (i >= a.points_w) break;
+            kernel::Rgba colour{0.0f, 0.0f, 0.0f, 0.0f};
+            batch_point(batch, acc, p, i, colour);
+            if (colours)
+                store_pixel(a, i, j,
+                            kernel::finish_blend(colour, weight_sum, a.rest, a.normal_map != 0, a.is_float != 0));
+        }
+        return;
+    }
+
+    // The block's points in pixels, grown by one lattice step: a grid
+    // point serves the cells on both sides of it.
+    const int bi0 = blockIdx.x * blockDim.x * PX, bi1 = bi0 + blockDim.x * PX;
+    const int bj0 = split ? blockIdx.y : blockIdx.y * blockDim.y, bj1 = split ? bj0 + 1 : bj0 + blockDim.y;
+    std::uint32_t mask = kernel::sources_meeting(a.bound, a.sources, (bi0 - 1) * sp, (bj0 - 1) * sp,
+                                                 (bi1 - 1) * sp + sp, (bj1 - 1) * sp + sp);
+    kernel::Rgba colour[PX];
+#pragma unroll
+    for (int p = 0; p < PX; ++p) colour[p] = {0.0f, 0.0f, 0.0f, 0.0f};
+    float weight_sum = 0.0f;
+    kernel::Batch<K> batch;
+    while (kernel::take_batch(mask, batch)) {  // the same batches for the whole block
+        Accum<K, PX> acc;
+        sum_lines(batch, acc);
         weight_sum += batch_weight(a, batch);
         if (!writes || j >= a.points_h) continue;
 #pragma unroll
         for (int p = 0; p < PX; ++p) {
             const int i = i0 + p;
             if (i >= a.points_w) break;
-            if (a.out_kind == OutKind::Sums) {
-                kernel::store_frame_sums(acc, p, batch,
-                                         a.sums + (static_cast<std::size_t>(j) * a.points_w + i) * sums_stride(a.sources));
-                continue;
-            }
-            float dx[K], dy[K];
-            kernel::displacement(acc, p, a.extent, dx, dy);
-            if (a.out_kind == OutKind::Displacement) {
-                float2* d = a.disp + (static_cast<std::size_t>(j) * a.points_w + i) * a.sources;
-#pragma unroll
-                for (int k = 0; k < K; ++k)
-                    if (k < batch.n) d[batch.slot[k]] = make_float2(dx[k], dy[k]);
-                continue;
-            }
-            kernel::blend_batch<K>(a.key, a.weight, batch, static_cast<float>(i) + 0.5f, static_cast<float>(j) + 0.5f,
-                                   dx, dy, colour[p]);
+            batch_point(batch, acc, p, i, colour[p]);
         }
     }
-    if (!writes || j >= a.points_h || a.out_kind == OutKind::Sums || a.out_kind == OutKind::Displacement) return;
+    if (!writes || j >= a.points_h || !colours) return;
 #pragma unroll
     for (int p = 0; p < PX; ++p) {
         const int i = i0 + p;
@@ -275,29 +326,57 @@ __global__ void __launch_bounds__(128) tile_kernel(const __grid_constant__ Kerne
                                        S4);
 }
 
+// Adds the batch's sources at pixel (px, py) displaced by (dx, dy) to
+// `sum`. A whole key goes through the texture unit where the frame's
+// weights sum to at most 1 (hw_filter): its 8-bit interpolation weights
+// then stay within the CPU parity tolerance, while keys adding up over
+// rest (weights summing to several) multiply that error, and are sampled
+// by hand like the CPU, as are cropped keys (rest outside the crop).
+template <int K>
+__device__ EMOFACE_INLINE void sample_batch(const KernelArgs& a, const kernel::Batch<K>& batch, float px, float py,
+                                            const float (&dx)[K], const float (&dy)[K], kernel::Rgba& sum) {
+    const float unit = a.is_float ? 1.0f : 255.0f;
+#pragma unroll
+    for (int k = 0; k < K; ++k) {
+        if (k >= batch.n) break;
+        const int i = batch.slot[k];
+        const kernel::ImageView& key = a.key[i];
+        if (a.hw_filter && key.crop_w == a.width && key.crop_h == a.height) {
+            const float4 t = tex2D<float4>(a.tex[i], px + dx[k], py + dy[k]);
+            kernel::add_weighted(sum, {t.x, t.y, t.z, t.w}, a.weight[i] * unit);
+        } else {
+            kernel::add_weighted(sum, kernel::sample_bilinear(key, px + dx[k], py + dy[k]), a.weight[i]);
+        }
+    }
+}
+
 // Fast mode, pass 3: four pixels of one row a thread, all in one cell
 // (fast_cell is a multiple of 4); a warp covers 32 x 4 pixels, so its loads
 // of grid corners and its texture fetches stay local. Per batch of the
 // sources evaluated in the cell, its corner sums are interpolated (less the
 // near lines' terms, where it has any), then the near lines are added
-// exactly (kernel.h, "fast mode") and the keys sampled: whole keys through
-// the texture unit, cropped ones by hand (rest outside the crop).
-template <int K, Law L>
+// exactly (kernel.h, "fast mode") and the keys sampled (sample_batch).
+// One: as in warp_kernel, the frame's sources are one batch evaluated
+// everywhere, and moreover all whole keys sampled by the texture unit
+// (hw_filter): the corners are read with 16-byte loads, records are
+// compile-time sized, and each pixel is finished as soon as its batch is
+// (no colour kept across batches and no hand-sampling code, either of
+// which spills under the 3-blocks-an-SM register budget).
+template <int K, Law L, bool One>
 __global__ void __launch_bounds__(256, 3) apply_kernel(const __grid_constant__ KernelArgs a,
                                                     const __grid_constant__ LineTable table) {
     const int x0 = (blockIdx.x * blockDim.x + threadIdx.x) * 4;
     const int y = blockIdx.y * blockDim.y + threadIdx.y;
     if (x0 >= a.width || y >= a.height) return;
-    const kernel::FastGrid g = fast_grid(a, table);
+    kernel::FastGrid g = fast_grid(a, table);
+    if constexpr (One) g.record_floats = kernel::record_floats(K);  // the frame's K sources
     const int tx = x0 / a.cell, ty = y / a.cell;
     const int tile = ty * a.tiles_w + tx;
-    std::uint32_t mask = cell_sources(a, tx, ty);
     const int count = a.near_count[tile];
     const unsigned short* list = a.near_list + static_cast<std::size_t>(tile) * kernel::kMaxNear;
     const float inv = a.inv_extent;
     const float xi = (static_cast<float>(x0) + 0.5f) * inv, yi = (static_cast<float>(y) + 0.5f) * inv;
     const bool crowded = count > kernel::kMaxNear;  // every line, exactly
-    const float unit = a.is_float ? 1.0f : 255.0f;
 
     // The cell's corner sums: from the grid, or from pass 2 where the cell
     // has near lines.
@@ -316,67 +395,97 @@ __global__ void __launch_bounds__(256, 3) apply_kernel(const __grid_constant__ K
     }
     const float fy = static_cast<float>(y - ty * a.cell) * a.inv_cell;
 
-    kernel::Rgba colour[4];
-#pragma unroll
-    for (int p = 0; p < 4; ++p) colour[p] = {0.0f, 0.0f, 0.0f, 0.0f};
-    float weight_sum = 0.0f;
-    kernel::Batch<K> batch;
-    while (kernel::take_batch(mask, batch)) {
-        // The cell's two columns interpolated to this row, for the batch.
-        float left[kernel::sum_floats(K)], right[kernel::sum_floats(K)];
-        if (!crowded) {
-            kernel::cell_row_end(c00, c01, fy, batch, left);
-            kernel::cell_row_end(c10, c11, fy, batch, right);
-        }
-        weight_sum += batch_weight(a, batch);
-#pragma unroll
-        for (int p = 0; p < 4; ++p) {
-            const int x = x0 + p;
-            const float xp = xi + static_cast<float>(p) * inv;
-            Accum<K, 1> acc;
-            kernel::cell_run<K, 1, L>(g, list, count, left, right, x - tx * a.cell, xp, yi, batch, acc);
-            float dx[K], dy[K];
-            kernel::displacement(acc, 0, a.extent, dx, dy);
-            if (a.out_kind == OutKind::Displacement) {
-                if (x < a.width) {
-                    float2* d = a.disp + (static_cast<std::size_t>(y) * a.width + x) * a.sources;
-#pragma unroll
-                    for (int k = 0; k < K; ++k)
-                        if (k < batch.n) d[batch.slot[k]] = make_float2(dx[k], dy[k]);
-                }
-                continue;
-            }
-            const float px = static_cast<float>(x) + 0.5f, py = static_cast<float>(y) + 0.5f;
-#pragma unroll
-            for (int k = 0; k < K; ++k) {
-                if (k >= batch.n) break;
-                const int i = batch.slot[k];
-                const kernel::ImageView& key = a.key[i];
-                if (key.crop_w == a.width && key.crop_h == a.height) {
-                    const float4 t = tex2D<float4>(a.tex[i], px + dx[k], py + dy[k]);
-                    kernel::add_weighted(colour[p], {t.x, t.y, t.z, t.w}, a.weight[i] * unit);
-                } else {
-                    kernel::add_weighted(colour[p], kernel::sample_bilinear(key, px + dx[k], py + dy[k]), a.weight[i]);
-                }
-            }
-        }
-    }
-    if (a.out_kind == OutKind::Displacement) return;
-
     // RGBA8 into a plain buffer goes out as one 16-byte store per thread;
     // anything else is stored pixel by pixel.
     const bool vector_store = a.out_vector && a.out_kind == OutKind::Pixels && !a.is_float && x0 + 3 < a.width;
     unsigned int packed[4];
-#pragma unroll
-    for (int p = 0; p < 4; ++p) {
-        const int x = x0 + p;
-        const kernel::Rgba c = kernel::finish_blend(colour[p], weight_sum, a.rest, a.normal_map != 0, a.is_float != 0);
+    auto finish = [&](int p, const kernel::Rgba& colour, float weight_sum) {
+        const kernel::Rgba c = kernel::finish_blend(colour, weight_sum, a.rest, a.normal_map != 0, a.is_float != 0);
         if (vector_store)
             packed[p] = kernel::pack_rgba8(c);
-        else if (x < a.width)
-            store_pixel(a, x, y, c);
+        else if (x0 + p < a.width)
+            store_pixel(a, x0 + p, y, c);
+    };
+    // Pixel p's result for the batch, from the cell row's ends: its
+    // displacements, or its sources sampled and added to `colour`.
+    auto batch_pixel = [&](const kernel::Batch<K>& batch, const float* left, const float* right, int p,
+                           kernel::Rgba& colour) {
+        const int x = x0 + p;
+        Accum<K, 1> acc;
+        kernel::cell_run<K, 1, L>(g, list, count, left, right, x - tx * a.cell, xi + static_cast<float>(p) * inv, yi,
+                                  batch, acc);
+        float dx[K], dy[K];
+        kernel::displacement(acc, 0, a.extent, dx, dy);
+        if (a.out_kind == OutKind::Displacement) {
+            if (x < a.width) {
+                float2* d = a.disp + (static_cast<std::size_t>(y) * a.width + x) * a.sources;
+#pragma unroll
+                for (int k = 0; k < K; ++k)
+                    if (k < batch.n) d[batch.slot[k]] = make_float2(dx[k], dy[k]);
+            }
+            return;
+        }
+        const float px = static_cast<float>(x) + 0.5f, py = static_cast<float>(y) + 0.5f;
+        if constexpr (One) {
+            const float unit = a.is_float ? 1.0f : 255.0f;
+#pragma unroll
+            for (int k = 0; k < K; ++k) {
+                const float4 t = tex2D<float4>(a.tex[k], px + dx[k], py + dy[k]);
+                kernel::add_weighted(colour, {t.x, t.y, t.z, t.w}, a.weight[k] * unit);
+            }
+        } else {
+            sample_batch(a, batch, px, py, dx, dy, colour);
+        }
+    };
+
+    if constexpr (One) {
+        constexpr int S4 = sums_stride(K) / 4;
+        const kernel::Batch<K> batch = kernel::all_sources<K>();
+        // kernel::cell_row_end for every source, with 16-byte loads.
+        float4 left[S4], right[S4];
+        if (!crowded) {
+            const float4 *q00 = reinterpret_cast<const float4*>(c00), *q01 = reinterpret_cast<const float4*>(c01);
+            const float4 *q10 = reinterpret_cast<const float4*>(c10), *q11 = reinterpret_cast<const float4*>(c11);
+#pragma unroll
+            for (int q = 0; q < S4; ++q) {
+                const float4 t0 = __ldg(q00 + q), b0 = __ldg(q01 + q), t1 = __ldg(q10 + q), b1 = __ldg(q11 + q);
+                left[q] = make_float4(t0.x + fy * (b0.x - t0.x), t0.y + fy * (b0.y - t0.y),
+                                      t0.z + fy * (b0.z - t0.z), t0.w + fy * (b0.w - t0.w));
+                right[q] = make_float4(t1.x + fy * (b1.x - t1.x), t1.y + fy * (b1.y - t1.y),
+                                       t1.z + fy * (b1.z - t1.z), t1.w + fy * (b1.w - t1.w));
+            }
+        }
+        const float weight_sum = batch_weight(a, batch);
+#pragma unroll
+        for (int p = 0; p < 4; ++p) {
+            kernel::Rgba colour{0.0f, 0.0f, 0.0f, 0.0f};
+            batch_pixel(batch, reinterpret_cast<const float*>(left), reinterpret_cast<const float*>(right), p,
+                        colour);
+            if (a.out_kind != OutKind::Displacement) finish(p, colour, weight_sum);
+        }
+    } else {
+        std::uint32_t mask = cell_sources(a, tx, ty);
+        kernel::Rgba colour[4];
+#pragma unroll
+        for (int p = 0; p < 4; ++p) colour[p] = {0.0f, 0.0f, 0.0f, 0.0f};
+        float weight_sum = 0.0f;
+        kernel::Batch<K> batch;
+        while (kernel::take_batch(mask, batch)) {
+            // The cell's two columns interpolated to this row, for the batch.
+            float left[kernel::sum_floats(K)], right[kernel::sum_floats(K)];
+            if (!crowded) {
+                kernel::cell_row_end(c00, c01, fy, batch, left);
+                kernel::cell_row_end(c10, c11, fy, batch, right);
+            }
+            weight_sum += batch_weight(a, batch);
+#pragma unroll
+            for (int p = 0; p < 4; ++p) batch_pixel(batch, left, right, p, colour[p]);
+        }
+        if (a.out_kind == OutKind::Displacement) return;
+#pragma unroll
+        for (int p = 0; p < 4; ++p) finish(p, colour[p], weight_sum);
     }
-    if (vector_store) {
+    if (vector_store && a.out_kind != OutKind::Displacement) {
         unsigned char* row = a.out + static_cast<std::size_t>(y) * a.out_pitch;
         reinterpret_cast<uint4*>(row)[x0 / 4] = make_uint4(packed[0], packed[1], packed[2], packed[3]);
     }
@@ -398,6 +507,26 @@ void with_sources_and_law(const FramePlan& plan, Fn&& fn) {
 
 template <int N>
 using Int = std::integral_constant<int, N>;
+
+// The frame's sources are one batch evaluated everywhere (warp_kernel,
+// apply_kernel: One).
+bool one_batch(const FramePlan& plan, int width, int height) {
+    if (plan.sources > kernel::kMaxBatch) return false;
+    for (int i = 0; i < plan.sources; ++i) {
+        const kernel::Bound& b = plan.bound[i];
+        if (b.x0 > 0 || b.y0 > 0 || b.x1 < width || b.y1 < height) return false;
+    }
+    return true;
+}
+
+// fn(std::bool_constant<one>{}).
+template <class Fn>
+void with_one(bool one, Fn&& fn) {
+    if (one)
+        fn(std::true_type{});
+    else
+        fn(std::false_type{});
+}
 
 // ---- the backend -------------------------------------------------------------
 
@@ -444,6 +573,9 @@ public:
         a.normal_map = plan.normal_map ? 1 : 0;
         a.sources = plan.sources;
         a.rest = plan.rest;
+        float weight_total = 0.0f;
+        for (int i = 0; i < plan.sources; ++i) weight_total += plan.weight[i];
+        a.hw_filter = weight_total <= 1.0f + kernel::kConvexSlack ? 1 : 0;
         for (int i = 0; i < plan.sources; ++i) {
             const int k = plan.source_index[i];
             const Crop& c = crops_[k];
@@ -532,7 +664,12 @@ public:
                 constexpr Law L = decltype(law)::value;
                 tile_kernel<K, L><<<static_cast<unsigned>((tiles + 127) / 128), 128, 0, stream_>>>(a, table_);
                 EMOFACE_CUDA_CHECK(cudaGetLastError());
-                apply_kernel<K, L><<<blocks, block, 0, stream_>>>(a, table_);
+                bool textured = a.hw_filter != 0;
+                for (int i = 0; i < plan.sources; ++i)
+                    textured = textured && a.key[i].crop_w == width_ && a.key[i].crop_h == height_;
+                with_one(textured && one_batch(plan, width_, height_), [&](auto one) {
+                    apply_kernel<K, L, decltype(one)::value><<<blocks, block, 0, stream_>>>(a, table_);
+                });
             });
             EMOFACE_CUDA_CHECK(cudaGetLastError());
         }
@@ -594,11 +731,15 @@ private:
         const std::size_t smem = a.chunk_lines * record_bytes + reduce;
         if (split) blocks.y = a.points_h;
         // 8 and 2 points a thread only for up to 3 sources (registers).
+        const bool one = one_batch(plan, width_, height_);
         with_sources_and_law(plan, [&](auto k, auto law) {
             constexpr int K = decltype(k)::value;
             constexpr Law L = decltype(law)::value;
             auto launch = [&](auto points) {
-                warp_kernel<K, decltype(points)::value, L><<<blocks, block, smem, stream_>>>(a, table_);
+                with_one(one, [&](auto o) {
+                    warp_kernel<K, decltype(points)::value, L, decltype(o)::value>
+                        <<<blocks, block, smem, stream_>>>(a, table_);
+                });
             };
             if constexpr (K <= 3) {
                 if (px == 8) return launch(Int<8>{});

@@ -136,6 +136,19 @@ EMOFACE_HD EMOFACE_INLINE bool take_batch(std::uint32_t& mask, Batch<K>& batch) 
     return batch.n > 0;
 }
 
+// Sources 0..K-1 as one batch: a frame of K <= kMaxBatch sources evaluated
+// everywhere (no regions) needs no other. Its slots are compile-time
+// constants once inlined, so the GPU reads a record's sources at fixed
+// offsets.
+template <int K>
+EMOFACE_HD EMOFACE_INLINE Batch<K> all_sources() {
+    Batch<K> batch;
+    batch.n = K;
+    EMOFACE_UNROLL
+    for (int k = 0; k < K; ++k) batch.slot[k] = k;
+    return batch;
+}
+
 // A frame's batch width (min(sources, kMaxBatch), known at run time) as a
 // compile-time K: calls fn(std::integral_constant<int, K>{}), so the sums of
 // each source of a batch live in registers. The one place a backend turns
