@@ -272,9 +272,13 @@ double Painter::hair(glm::dvec3 q, Rgb* colour) const {
                            0.35 * noise(across / (0.5 * w), along / (0.25 * len), 2.0) +
                            0.2 * noise(across / (2.3 * w), along / len, 3.0);
     const double clump_edge = std::abs(cu - ci - 0.5) * 2.0;  // 0 mid-clump .. 1 between clumps
-    double value = 0.85 + 0.9 * (strands - 0.5) - 0.3 * clump_edge * clump_edge;
+    double value = 0.85 + 0.9 * (strands - 0.5) - 0.45 * clump_edge * clump_edge;
     value *= 1.0 + p_.hair_tip_lightening * glm::smoothstep(0.4, 1.0, tip);
-    value *= 0.9 + 0.2 * noise(q.x * 0.05, q.y * 0.05, q.z * 0.05 + 9.0);
+    // Clumps and tufts differ in tone, and broad patches (about 12 mm) are
+    // lighter or darker: an even tone and one sheen over the crown read as a
+    // cap; these break the albedo's relief, and with it the highlight, up.
+    value *= 0.82 + 0.36 * hash(ci, 11, 5);
+    value *= 0.72 + 0.56 * noise(q.x * 0.08, q.y * 0.08, q.z * 0.08 + 9.0);
     *colour = from255(p_.hair) * std::max(value, 0.15);
 
     // The hairline: hair thins over the band, the strands parting so that
