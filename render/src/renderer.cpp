@@ -143,6 +143,16 @@ GLuint upload_srgb_texture(const ImageRGBA8& image) {
                           image.width, image.height, flipped.data());
 }
 
+// The base colour's relief (skin_maps.h): RG half floats, mipmapped (the
+// filtered slopes are those of the filtered height), rows bottom first like
+// the base texture.
+GLuint upload_detail_map(const ImageRGBA8& image, float mean_levels) {
+    const std::vector<float> slopes = detail::albedo_detail_slopes(image, mean_levels);
+    return upload_texture({GL_RG16F, GL_RG, GL_FLOAT, 4, true, GL_CLAMP_TO_EDGE,
+                           "uploading a base texture's relief"},
+                          image.width, image.height, slopes.data());
+}
+
 // The pre-integrated scattering table: clamped, bilinear, RGB half floats.
 constexpr int kScatterTableWidth = 128;   // N.L
 constexpr int kScatterTableHeight = 64;   // curvature
@@ -169,6 +179,10 @@ struct Renderer::Impl {
     struct Mesh {
         Material material;
         GLuint base_texture = 0;
+        // The skin's relief baked from the base texture, made on the first
+        // skin draw and again when the mean it is taken against changes.
+        GLuint detail_texture = 0;
+        float detail_levels = 0.0f;
         GLuint vao = 0, shape_vbo = 0, frame_vbo = 0, static_vbo = 0, ebo = 0;
         GLsizei index_count = 0;
         std::size_t vertex_count = 0;
@@ -185,7 +199,7 @@ struct Renderer::Impl {
             wrinkle_map, use_wrinkle_map, wrinkle_signed, light_position, light_ambient,
             light_diffuse, light_specular, specular_color, shininess, camera_position, projective,
             box, skin_model, skin_surface, scatter_table, max_curvature, mm_per_unit,
-            normal_softening, cavity_direct, pore_map, pore_tiles, pore_strength, albedo_bump, albedo_bump_bias, f0, roughness,
+            normal_softening, cavity_direct, pore_map, pore_tiles, pore_strength, detail_map, albedo_bump, f0, roughness,
             lobe_weight, fill_direction, fill_colour, rim_direction, rim_colour, sky, ground,
             exposure, tone_map;
     } loc{};
@@ -205,6 +219,8 @@ struct Renderer::Impl {
 
     void release(Mesh& m) {
         if (m.base_texture) glDeleteTextures(1, &m.base_texture);
+        if (m.detail_texture) glDeleteTextures(1, &m.detail_texture);
+        m.detail_texture = 0;
         const GLuint buffers[4] = {m.shape_vbo, m.frame_vbo, m.static_vbo, m.ebo};
         glDeleteBuffers(4, buffers);
         if (m.vao) glDeleteVertexArrays(1, &m.vao);
@@ -273,7 +289,7 @@ Renderer::Renderer(Platform& platform) : impl_(std::make_unique<Impl>(platform))
     l.pore_tiles = u("u_pore_tiles");
     l.pore_strength = u("u_pore_strength");
     l.albedo_bump = u("u_albedo_bump");
-    l.albedo_bump_bias = u("u_albedo_bump_bias");
+    l.detail_map = u("u_detail_map");
     l.f0 = u("u_f0");
     l.roughness = u("u_roughness");
     l.lobe_weight = u("u_lobe_weight");
@@ -384,7 +400,9 @@ void Renderer::set_material(MeshId id, const Material& material) {
     GLuint texture = 0;
     if (material.base_texture) texture = upload_srgb_texture(*material.base_texture);
     if (m.base_texture) glDeleteTextures(1, &m.base_texture);
+    if (m.detail_texture) glDeleteTextures(1, &m.detail_texture);
     m.base_texture = texture;
+    m.detail_texture = 0;
     m.material = material;
 }
 
@@ -512,7 +530,16 @@ void Renderer::draw(const DrawOptions& o, const WrinkleTexture* wrinkle_map) {
         glUniform1f(im.loc.pore_tiles, k.pore_tiles);
         glUniform1f(im.loc.pore_strength, k.pore_strength);
         glUniform1f(im.loc.albedo_bump, k.albedo_bump_mm / k.mm_per_unit);
-        glUniform1f(im.loc.albedo_bump_bias, k.albedo_bump_bias);
+        glUniform1i(im.loc.detail_map, 4);
+        glActiveTexture(GL_TEXTURE4);
+        for (auto& m : im.meshes) {
+            const bool wanted = k.albedo_bump_mm > 0.0f && m.material.base_texture && m.material.uses_wrinkle_map;
+            if (!wanted || (m.detail_texture && m.detail_levels == k.albedo_bump_bias)) continue;
+            const GLuint t = upload_detail_map(*m.material.base_texture, k.albedo_bump_bias);
+            if (m.detail_texture) glDeleteTextures(1, &m.detail_texture);
+            m.detail_texture = t;
+            m.detail_levels = k.albedo_bump_bias;
+        }
         glUniform1f(im.loc.f0, k.f0);
         glUniform2f(im.loc.roughness, k.roughness[0], k.roughness[1]);
         glUniform1f(im.loc.lobe_weight, k.lobe_weight);
@@ -534,6 +561,10 @@ void Renderer::draw(const DrawOptions& o, const WrinkleTexture* wrinkle_map) {
         glUniform3fv(im.loc.base_color, 1, glm::value_ptr(m.material.base_color));
         glUniform3fv(im.loc.specular_color, 1, glm::value_ptr(m.material.specular_color));
         glUniform1f(im.loc.shininess, m.material.shininess);
+        if (skin_model) {
+            glActiveTexture(GL_TEXTURE4);
+            glBindTexture(GL_TEXTURE_2D, m.detail_texture);
+        }
         glActiveTexture(GL_TEXTURE0);
         glBindTexture(GL_TEXTURE_2D, m.base_texture);
         glBindVertexArray(m.vao);
@@ -541,6 +572,8 @@ void Renderer::draw(const DrawOptions& o, const WrinkleTexture* wrinkle_map) {
     }
     glBindVertexArray(0);
     if (skin_model) {
+        glActiveTexture(GL_TEXTURE4);
+        glBindTexture(GL_TEXTURE_2D, 0);
         glActiveTexture(GL_TEXTURE3);
         glBindTexture(GL_TEXTURE_2D, 0);
         glActiveTexture(GL_TEXTURE2);

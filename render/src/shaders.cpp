@@ -97,8 +97,8 @@ uniform float u_cavity_direct;
 uniform sampler2D u_pore_map;       // rgb normal, a cavity
 uniform float u_pore_tiles;
 uniform float u_pore_strength;
-uniform float u_albedo_bump;        // detail height (scene units) per unit of log-luminance contrast
-uniform float u_albedo_bump_bias;   // mip levels up to the local mean the contrast is taken against
+uniform sampler2D u_detail_map;     // rg: the base colour's relief, slopes per base UV (skin_maps.h)
+uniform float u_albedo_bump;        // detail height (scene units) per unit of the relief
 uniform float u_f0;
 uniform vec2 u_roughness;
 uniform float u_lobe_weight;
@@ -217,10 +217,10 @@ vec3 shade_light(Surface s, vec3 l, vec3 c, const bool full) {
 
 // `gloss`: the base map's alpha, the region's roughness scale (lips, the
 // tear line and the T-zone below 1; 1 where a map has no such regions).
-// `detail`: the base colour's log-luminance above its local mean, a height
-// in scene units (hair strands, brow hairs, lip lines stand out of the darker
-// gaps between them).
-vec3 shade_skin(vec3 n_bumped, vec3 n_geo, vec3 base, float cavity, float gloss, float detail) {
+// `slope`: the base colour's relief (its log-luminance above its local mean,
+// baked at load), d height / d base UV in scene units: hair strands, brow
+// hairs and lip lines stand out of the darker gaps between them.
+vec3 shade_skin(vec3 n_bumped, vec3 n_geo, vec3 base, float cavity, float gloss, vec2 slope) {
     Surface s;
     s.v = normalize(u_camera_position - v_position);
     s.cavity = cavity;
@@ -247,10 +247,11 @@ vec3 shade_skin(vec3 n_bumped, vec3 n_geo, vec3 base, float cavity, float gloss,
             vec3 tilted = n_bumped * pn.z + u_pore_strength * scale * (t * pn.x + b * pn.y);
             if (dot(tilted, tilted) > 1e-12) s.n = normalize(tilted);
         }
-        // The albedo's detail as a bump (Mikkelsen 2010, surface gradient
-        // from screen derivatives of the height).
+        // The albedo's relief as a bump (Mikkelsen 2010, surface gradient):
+        // t and b are the frame of uv = base UV x tiles scaled by det, so
+        // the height's gradient is (h_u t + h_v b) / (tiles det).
         float det = dot(dp1, dp2perp);
-        vec3 gradient = sign(det) * (dFdx(detail) * dp2perp + dFdy(detail) * dp1perp);
+        vec3 gradient = sign(det) * (slope.x * t + slope.y * b);
         vec3 detailed = abs(det) * s.n - gradient;
         if (dot(detailed, detailed) > 1e-20) s.n = normalize(detailed);
         float variance = u_pore_strength * u_pore_strength * (1.0 - shortening) / shortening;
@@ -320,25 +321,19 @@ void main() {
         if (dot(bumped, bumped) > 1e-12) n = normalize(bumped);
     }
     vec3 base = u_base_color;
-    float gloss = 1.0, detail = 0.0;
+    float gloss = 1.0;
+    vec2 slope = vec2(0.0);
     if (u_has_base_map) {
         vec4 texel = texture(u_base_map, v_base_uv);
         base *= texel.rgb;
         if (u_skin_model) {
             gloss = texel.a;
-            if (u_albedo_bump > 0.0) {
-                const vec3 luma = vec3(0.2126, 0.7152, 0.0722);
-                vec3 mean = texture(u_base_map, v_base_uv, u_albedo_bump_bias).rgb;
-                // Clamped: the step from skin to a dark hair is a colour edge,
-                // not a cliff.
-                detail = u_albedo_bump * clamp(log(dot(texel.rgb, luma) + 0.004) - log(dot(mean, luma) + 0.004),
-                                               -0.5, 0.5);
-            }
+            if (u_skin_surface && u_albedo_bump > 0.0) slope = (u_albedo_bump / u_pore_tiles) * texture(u_detail_map, v_base_uv).rg;
         }
     }
 
     if (u_skin_model) {
-        vec3 color = u_exposure * shade_skin(n, n_geo, base, cavity, gloss, detail);
+        vec3 color = u_exposure * shade_skin(n, n_geo, base, cavity, gloss, slope);
         frag_color = vec4(srgb_encode(u_tone_map ? tone_map(color) : color), 1.0);
         return;
     }

@@ -154,4 +154,64 @@ std::vector<std::uint8_t> pore_map(const PoreMapSpec& spec) {
     return out;
 }
 
+std::vector<float> albedo_detail_slopes(const ImageRGBA8& image, float mean_levels) {
+    const int w = image.width, h = image.height;
+    if (w < 2 || h < 2 || image.pixels.size() != std::size_t(w) * h * 4 || !(mean_levels > 0.0f))
+        fail("render: albedo detail of a {}x{} image with {} bytes (expected width*height*4, at least 2x2) "
+             "over {} mip levels (expected > 0)",
+             w, h, image.pixels.size(), mean_levels);
+    double to_linear[256];
+    for (int i = 0; i < 256; ++i) {
+        const double c = i / 255.0;
+        to_linear[i] = c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+    }
+    // Linear luminance, rows bottom first.
+    const std::size_t count = std::size_t(w) * h;
+    std::vector<double> luma(count), mean(count), tmp(count);
+    for (int r = 0; r < h; ++r)
+        for (int x = 0; x < w; ++x) {
+            const std::uint8_t* p = image.at(x, h - 1 - r);
+            luma[std::size_t(r) * w + x] =
+                0.2126 * to_linear[p[0]] + 0.7152 * to_linear[p[1]] + 0.0722 * to_linear[p[2]];
+        }
+    // The local mean: two passes of a box of 2 radius + 1 texels (clamped at
+    // the edges), wide enough that the hair's clumps, not only its single
+    // strands, stand out: the strands average away in the mips when the head
+    // is seen whole, the clumps still break up its sheen.
+    const int radius = std::max(1, int(std::lround(0.375 * std::exp2(double(mean_levels) + 2.0))));
+    auto box = [&](const std::vector<double>& in, std::vector<double>& out, bool along_rows) {
+        const int n = along_rows ? w : h, lines = along_rows ? h : w;
+        for (int l = 0; l < lines; ++l) {
+            auto at = [&](int k) {
+                k = std::clamp(k, 0, n - 1);
+                return along_rows ? std::size_t(l) * w + k : std::size_t(k) * w + l;
+            };
+            double sum = 0.0;
+            for (int k = -radius; k <= radius; ++k) sum += in[at(k)];
+            for (int k = 0; k < n; ++k) {
+                out[at(k)] = sum / (2 * radius + 1);
+                sum += in[at(k + radius + 1)] - in[at(k - radius)];
+            }
+        }
+    };
+    box(luma, tmp, true);
+    box(tmp, mean, false);
+    box(mean, tmp, true);
+    box(tmp, mean, false);
+    std::vector<double> height(count);
+    for (std::size_t i = 0; i < count; ++i)
+        height[i] = std::clamp(std::log(luma[i] + 0.004) - std::log(mean[i] + 0.004), -0.5, 0.5);
+    std::vector<float> out(count * 2);
+    for (int r = 0; r < h; ++r)
+        for (int x = 0; x < w; ++x) {
+            auto at = [&](int xx, int rr) {
+                return height[std::size_t(std::clamp(rr, 0, h - 1)) * w + std::size_t(std::clamp(xx, 0, w - 1))];
+            };
+            const std::size_t i = std::size_t(r) * w + x;
+            out[2 * i + 0] = float(0.5 * (at(x + 1, r) - at(x - 1, r)) * w);
+            out[2 * i + 1] = float(0.5 * (at(x, r + 1) - at(x, r - 1)) * h);
+        }
+    return out;
+}
+
 }  // namespace emoface::render::detail

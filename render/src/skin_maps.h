@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "emoface/render/image.h"
 #include "emoface/render/skin_shading.h"
 
 namespace emoface::render::detail {
@@ -20,5 +21,17 @@ std::vector<float> preintegrated_scatter_table(const SkinShading& skin, int widt
 // RGB = 0.5 + 0.5 n (n.x along the tile's columns, n.y along its rows, n.z
 // out of the skin); A = cavity, 255 on open skin, lower in the pits.
 std::vector<std::uint8_t> pore_map(const PoreMapSpec& spec);
+
+// The base colour's fine relief, baked once so the shader needs neither a
+// second look-up of the colour nor derivatives of a height: the height is
+// the linear luminance's log above its local mean (two box blurs spanning
+// about 2^(mean_levels + 2) texels: what a look-up mean_levels mip levels up
+// averaged at the default framing, where the base map is already about two
+// levels minified), clamped to +-0.5 (the step from skin to a dark hair
+// is a colour edge, not a cliff), and the result is its slopes (dh/du,
+// dh/dv per unit of the base UVs), width x height RG float pairs, rows
+// bottom first as the base texture is uploaded (v up). Hair strands, brow
+// hairs and lip lines, lighter than the gaps between them, stand out.
+std::vector<float> albedo_detail_slopes(const ImageRGBA8& image, float mean_levels);
 
 }  // namespace emoface::render::detail

@@ -565,6 +565,39 @@ TEST_F(SkinQuad, BaseMapAlphaNarrowsTheSheen) {
     EXPECT_NEAR(rough_peak, draw(glm::vec3(0.0f), 0.0f, head_on, skin).g, 0.002f);
 }
 
+// The base colour's relief, baked at load into slopes (render/src/skin_maps.h):
+// at a step from a light half (left, -x) to a dark one the surface steps
+// down towards +x, so its normal leans to +x and a light from +x lights it
+// more than the mirrored light from -x; without the relief both are equal.
+TEST_F(SkinQuad, AlbedoReliefLeansTheNormalDownItsSlope) {
+    SkinShading skin = dark_rig();
+    skin.pore_strength = 0.0f;
+    Material m;
+    auto base = std::make_shared<ImageRGBA8>(16, 16);
+    for (int y = 0; y < 16; ++y)
+        for (int x = 0; x < 16; ++x) {
+            std::uint8_t* p = base->at(x, y);
+            p[0] = p[1] = p[2] = x < 8 ? 200 : 90;
+            p[3] = 255;
+        }
+    m.base_texture = base;
+    m.uses_wrinkle_map = true;  // a skin surface
+    auto lit_from = [&](float side) {
+        Light light;
+        light.position = glm::vec4(glm::normalize(glm::vec3(side, 0.0f, 0.6f)), 0.0f);
+        light.diffuse = glm::vec3(1.0f);
+        return draw(m, 0.0f, light, skin).g;
+    };
+    skin.albedo_bump_mm = 0.0f;
+    const float flat_plus = lit_from(1.0f), flat_minus = lit_from(-1.0f);
+    EXPECT_NEAR(flat_plus, flat_minus, 0.01f * flat_plus) << "no relief: mirrored lights light it alike";
+    skin.albedo_bump_mm = 0.15f * skin.mm_per_unit;
+    const float plus = lit_from(1.0f), minus = lit_from(-1.0f);
+    EXPECT_GT(plus, 1.1f * minus) << "the step down towards +x faces the light from +x";
+    EXPECT_GT(plus, flat_plus);
+    EXPECT_LT(minus, flat_minus);
+}
+
 #ifdef EMOFACE_DATA_DIR
 // SkinShading's defaults are data/render/skin.json's values.
 TEST(SkinShadingData, DefaultsAreTheDataFile) {

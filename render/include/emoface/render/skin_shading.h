@@ -20,9 +20,10 @@
 //   regions   the base map's alpha scales both roughnesses (the painter's
 //             regions: lips, the tear line, the T-zone glossier than the
 //             cheeks; 1, the skin.json values, where a map has no alpha);
-//   detail    the base colour's fine log-luminance contrast (above its mean a
-//             few mip levels up) as a height: hair strands, brow hairs and lip
-//             lines catch the light along their direction;
+//   detail    the base colour's fine log-luminance contrast (above its local
+//             mean) as a height, baked into slopes when first drawn: hair
+//             strands, brow hairs and lip lines catch the light along their
+//             direction;
 //   light     the draw's key light, a fill and a rim light, a sky/ground
 //             hemisphere with specular occlusion (Lagarde & de Rousiers 2014)
 //             in the cavities; the sum is exposed, tone mapped (ACES fit,
@@ -110,7 +111,7 @@ struct SkinShading {
 
     // --- detail from the albedo ---
     float albedo_bump_mm = 0.5f;   // height per unit of log-luminance contrast
-    float albedo_bump_bias = 2.0f;  // mip levels up to the mean it is taken against
+    float albedo_bump_bias = 2.0f;  // the mean's extent, in mip levels (skin_maps.h)
 
     // --- light rig (the key light is the draw's Light) ---
     RigLight fill{{0.7f, 0.1f, 0.7f}, {0.16f, 0.17f, 0.19f}};
