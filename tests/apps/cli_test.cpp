@@ -311,20 +311,23 @@ TEST_F(AppsCli, WrinklesWritesKeysThatThePipelineReadsBack) {
     const std::string folder = path("keys");
     CommandResult r = run_emoface({"wrinkles", "--size", "256", "--out", folder});
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    for (const char* key : {"neutral", "joy", "sadness", "anger", "fear", "disgust", "surprise"}) {
+    // Neutral and one key per wrinkling AU side (wrinkles.json).
+    for (const char* key : {"neutral", "AU1L", "AU1R", "AU2L", "AU4R", "AU6L", "AU9L", "AU12R", "AU15L", "AU17"}) {
         const ImageRGBA8 map = emoface::render::read_image_rgba8(folder + "/" + key + ".png");
         EXPECT_EQ(map.width, 256) << key;
         EXPECT_TRUE(fs::exists(folder + "/" + std::string(key) + ".layout.json")) << key;
     }
     r = run_emoface(args_with({"mix", "anger=1", "--wrinkles", folder, "--out", path("generated.png")}, kSmall));
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    // The artist flattens the anger map: the render loses its anger wrinkles.
+    // The artist flattens anger's glabella key (AU4, both sides): the render
+    // loses its anger wrinkles there.
     ImageRGBA8 flat(256, 256);
     for (int i = 0; i < 256 * 256; ++i) {
         flat.pixels[i * 4 + 0] = flat.pixels[i * 4 + 1] = 128;
         flat.pixels[i * 4 + 2] = flat.pixels[i * 4 + 3] = 255;
     }
-    emoface::render::write_image(folder + "/anger.png", flat);
+    emoface::render::write_image(folder + "/AU4L.png", flat);
+    emoface::render::write_image(folder + "/AU4R.png", flat);
     r = run_emoface(args_with({"mix", "anger=1", "--wrinkles", folder, "--out", path("painted.png")}, kSmall));
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_GT(emoface::render::diff_images(emoface::render::read_image_rgba8(path("generated.png")),
@@ -332,10 +335,10 @@ TEST_F(AppsCli, WrinklesWritesKeysThatThePipelineReadsBack) {
                   .mean_diff,
               0.01);  // renders are deterministic: 0 had the folder been ignored
     // A folder that lacks a map is bad input, and nothing is written.
-    fs::remove(folder + "/fear.png");
+    fs::remove(folder + "/AU20L.png");
     r = run_emoface(args_with({"mix", "anger=1", "--wrinkles", folder, "--out", path("broken.png")}, kSmall));
     EXPECT_EQ(r.exit_code, 2);
-    EXPECT_NE(r.err.find("fear.png: missing wrinkle map"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("AU20L.png: missing wrinkle map"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(path("broken.png")));
     r = run_emoface({"wrinkles", "--size", "100", "--out", path("small")});
     EXPECT_EQ(r.exit_code, 2);

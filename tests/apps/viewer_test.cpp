@@ -346,9 +346,10 @@ int count_colour(const ImageRGBA8& img, const std::array<int, 3>& colour) {
 
 // The acceptance case of the viewer's options: `mix MIX` without --out opens
 // the viewer on the key maps of --wrinkles DIR (an artist's folder), not on
-// generated ones. The anger key is painted one tilted normal everywhere, so
-// at full anger the morphed map is that colour: the panel's wrinkle-map
-// preview shows it, and the face is lit by it.
+// generated ones. The neutral key (the skin under every frame; AU keys add
+// their wrinkles to it) is painted one tilted normal everywhere, so the
+// morphed map is that colour outside anger's wrinkles: the panel's
+// wrinkle-map preview shows it, and the face is lit by it.
 TEST_F(ViewUnderXvfb, MixWithoutOutShowsThePaintedWrinkleMaps) {
     const std::string generated = path("generated"), painted = path("painted");
     CommandResult r = run_emoface({"wrinkles", "--size", "256", "--out", generated});
@@ -357,13 +358,13 @@ TEST_F(ViewUnderXvfb, MixWithoutOutShowsThePaintedWrinkleMaps) {
     // n = (0.6, 0, 0.8): RGB = 0.5 + 0.5 n, a colour no generated map has
     // over a large area.
     const std::array<int, 3> tilted{204, 128, 230};
-    ImageRGBA8 anger(256, 256);
+    ImageRGBA8 neutral(256, 256);
     for (int y = 0; y < 256; ++y)
         for (int x = 0; x < 256; ++x) {
-            std::uint8_t* p = anger.at(x, y);
+            std::uint8_t* p = neutral.at(x, y);
             p[0] = std::uint8_t(tilted[0]), p[1] = std::uint8_t(tilted[1]), p[2] = std::uint8_t(tilted[2]), p[3] = 255;
         }
-    emoface::render::write_image(painted + "/anger.png", anger);
+    emoface::render::write_image(painted + "/neutral.png", neutral);
 
     // Every session option goes through to the viewer (a coarse face, small
     // textures, one sample: fast under llvmpipe).

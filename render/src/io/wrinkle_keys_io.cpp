@@ -54,6 +54,18 @@ std::vector<WrinkleKey> read_wrinkle_keys(const std::string& folder,
                              path.string(), name);
         names.push_back(name);
     }
+    // A layout whose map is gone is a key the artist lost, not one to skip:
+    // playing without it would silently drop that key's wrinkles.
+    for (const fs::directory_entry& entry : fs::directory_iterator(folder)) {
+        const std::string file = entry.path().filename().string();
+        const std::string suffix = ".layout.json";
+        if (file.size() <= suffix.size() || file.compare(file.size() - suffix.size(), suffix.size(), suffix) != 0)
+            continue;
+        const std::string name = file.substr(0, file.size() - suffix.size());
+        if (std::find(names.begin(), names.end(), name) == names.end())
+            fail<InputError>("render: {}.png: missing wrinkle map (its layout {} is there)",
+                             (fs::path(folder) / name).string(), file);
+    }
     if (std::find(names.begin(), names.end(), "neutral") == names.end())
         fail<InputError>("render: {}.png: missing wrinkle map", (fs::path(folder) / "neutral").string());
     std::sort(names.begin(), names.end(), [](const std::string& a, const std::string& b) {
