@@ -1,13 +1,19 @@
 #include "au_label.h"
 
+#include <cmath>
+
 #include <fmt/format.h>
 
 namespace emoface::apps {
 
 std::string au_label(const expression::AuIntensities& aus) {
-    // to_string keeps intensities above its threshold; a hair under 0.1 keeps
-    // 0.1 itself.
-    return aus.to_string(kShownAuIntensity - 1e-9);
+    // Shown to two decimals, as the mix is (to_string writes every digit, so
+    // that a mix string reads back exactly). Its threshold keeps intensities
+    // above it; a hair under 0.1 keeps 0.1 itself.
+    expression::AuIntensities shown = aus;
+    for (auto* side : {&shown.left, &shown.right})
+        for (double& w : *side) w = std::round(w * 100.0) / 100.0;
+    return shown.to_string(kShownAuIntensity - 1e-9);
 }
 
 std::string mix_label(const expression::EmotionMix& mix) {
