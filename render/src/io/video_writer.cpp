@@ -135,9 +135,9 @@ FrameSequenceWriter::FrameSequenceWriter(std::string pattern, int first_index)
             continue;
         }
         std::size_t j = i + 1;
-        while (j < pattern_.size() && (pattern_[j] == '0' || pattern_[j] == '-' ||
-                                       pattern_[j] == '+' || pattern_[j] == ' '))
-            ++j;
+        // Zero padding only: '-', '+' and ' ' would put spaces or signs in
+        // file names.
+        while (j < pattern_.size() && pattern_[j] == '0') ++j;
         while (j < pattern_.size() && std::isdigit(static_cast<unsigned char>(pattern_[j]))) ++j;
         if (j >= pattern_.size() || pattern_[j] != 'd' || j - i > 6)
             fail<InputError>("render: frame pattern '{}': only %d conversions (like %04d) are "
