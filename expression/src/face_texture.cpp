@@ -229,20 +229,9 @@ double Painter::brow_hairs(double x, double y, Rgb* colour) const {
 // (across) and the distance from it (along).
 double Painter::hair(glm::dvec3 q, Rgb* colour) const {
     const double ax = std::abs(q.x);
-    // Front: the hairline over the forehead, dropping at the temples.
-    const double tx = std::min(ax / p_.hairline_temple[0], 1.0);
-    const double front_line = mix(p_.hairline_y, p_.hairline_temple[1], tx * tx) -
-                              std::max(ax - p_.hairline_temple[0], 0.0) * 2.5;
-    // Side and back, by depth: the sideburn in front of the ear, a margin
-    // over the ear, then down to the nape.
-    const double ear_top = p_.ear_centre_yz[0] + p_.ear_radii_yz[0] + 5.0;
-    const double ear_front = p_.ear_centre_yz[1] + p_.ear_radii_yz[1] + 3.0;
-    const double ear_back = p_.ear_centre_yz[1] - p_.ear_radii_yz[1] - 3.0;
-    double side_line;
-    if (q.z > ear_front) side_line = mix(ear_top, p_.sideburn_bottom_y, glm::smoothstep(ear_front, ear_front + 5.0, q.z));
-    else if (q.z > ear_back) side_line = ear_top;
-    else side_line = mix(ear_top, p_.hair_back_bottom_y, glm::smoothstep(ear_back, ear_back - 35.0, q.z));
-    const double line = mix(side_line, front_line, glm::smoothstep(p_.sideburn_z - 6.0, p_.sideburn_z + 6.0, q.z));
+    // The hairline is the head's (FaceShape: the hair volume rises from the
+    // same line), so paint and geometry agree.
+    const double line = s_.hairline(q);
     // Height above the hairline, its course wandering gently (low-frequency
     // only: a saw-tooth edge reads as a wig).
     double edge = q.y - line + (noise(q.x * 0.09, q.y * 0.09, q.z * 0.09 + 5.0) - 0.5) * 4.0;
