@@ -6,7 +6,9 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <filesystem>
+#include <fstream>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -16,6 +18,7 @@
 
 #include "emoface/common/error.h"
 #include "emoface/common/timing.h"
+#include "emoface/expression/capture.h"
 #include "emoface/expression/default_face.h"
 #include "emoface/expression/face_io.h"
 #include "emoface/fap/fap_io.h"
@@ -41,6 +44,21 @@ void add_times(render::FrameStageTimes& a, const render::FrameStageTimes& b, dou
     a.upload_ms += scale * b.upload_ms;
 }
 
+// CPU time of the whole process (every thread), in milliseconds.
+double process_cpu_ms() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
+}
+
+// The 1-minute load average, for reading a wall-clock figure ("" where unknown).
+std::string load_average() {
+    std::ifstream in("/proc/loadavg");
+    std::string one;
+    if (!(in >> one)) return "";
+    return one;
+}
+
 }  // namespace
 
 // --- small shared helpers ---------------------------------------------------
@@ -50,6 +68,7 @@ void FrameTimeTotals::add(const FrameTimes& t) {
     sum.draw_ms += t.draw_ms;
     sum.readback_ms += t.readback_ms;
     sum.total_ms += t.total_ms;
+    sum.cpu_ms += t.cpu_ms;
     ++frames;
 }
 
@@ -61,6 +80,7 @@ FrameTimes FrameTimeTotals::mean() const {
     m.draw_ms = sum.draw_ms * s;
     m.readback_ms = sum.readback_ms * s;
     m.total_ms = sum.total_ms * s;
+    m.cpu_ms = sum.cpu_ms * s;
     return m;
 }
 
@@ -72,8 +92,11 @@ std::string format_times(const LoadTimes& load, const FrameTimeTotals& frames) {
         load.scene_ms);
     if (frames.frames > 0) {
         const FrameTimes m = frames.mean();
-        out += fmt::format("  per frame, mean of {}: {:.1f} ms ({:.1f} frames/s)\n", frames.frames, m.total_ms,
-                           m.total_ms > 0 ? 1000.0 / m.total_ms : 0.0);
+        const std::string load = load_average();
+        out += fmt::format("  per frame, mean of {}: {:.1f} ms ({:.1f} frames/s); CPU {:.1f} ms (user + sys, all "
+                           "threads){}\n",
+                           frames.frames, m.total_ms, m.total_ms > 0 ? 1000.0 / m.total_ms : 0.0, m.cpu_ms,
+                           load.empty() ? "" : "; load average " + load);
         out += fmt::format(
             "    rig {:.2f} | layout {:.2f} | morph {:.2f} | wrinkle UVs {:.2f} | tangents {:.2f} | "
             "upload {:.2f} | draw {:.2f} | read back {:.2f}\n"
@@ -85,8 +108,8 @@ std::string format_times(const LoadTimes& load, const FrameTimeTotals& frames) {
     return out;
 }
 
-fap::FapStream load_fap_stream(const std::string& path) {
-    fap::FapStream stream = fap::read_fap_file(path);
+fap::FapStream load_fap_stream(const std::string& path, const std::string& data) {
+    fap::FapStream stream = expression::read_animation_file(path, data).stream;
     if (stream.frames.empty()) fail<InputError>("fap: {}: the file has no frames", path);
     if (!(stream.fps > 0)) fail<InputError>("fap: {}: frame rate {} is not positive", path, stream.fps);
     return stream;
@@ -322,6 +345,7 @@ render::DrawOptions Session::draw_options(float aspect) const {
 
 render::ImageRGBA8 Session::render_frame(const expression::FaceState& state) {
     const auto t0 = Clock::now();
+    const double cpu0 = process_cpu_ms();
     update(state);
     platform_->begin_frame();
     render::DrawOptions d = draw_options(float(options_.width) / float(options_.height));
@@ -351,6 +375,7 @@ render::ImageRGBA8 Session::render_frame(const expression::FaceState& state) {
     render::ImageRGBA8 image = platform_->read_rgba();
     last_.readback_ms = ms_since(t);
     last_.total_ms = ms_since(t0);
+    last_.cpu_ms = process_cpu_ms() - cpu0;
     totals_.add(last_);
     return image;
 }

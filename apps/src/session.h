@@ -123,6 +123,10 @@ struct FrameTimes {
                                     // work included), in draw() its submission only
     double readback_ms = 0;         // resolve + read RGBA
     double total_ms = 0;            // the whole render_frame()
+    // The process's CPU time (user + sys, every thread: llvmpipe's
+    // rasterisers too) over the whole render_frame(): on a loaded machine
+    // the wall clock counts other programs' turns, this does not.
+    double cpu_ms = 0;
 };
 
 // Sums frame times to report means.
@@ -137,9 +141,10 @@ struct FrameTimeTotals {
 std::string format_times(const LoadTimes& load, const FrameTimeTotals& frames);
 
 
-// Reads a FAP file for playing; InputError when it has no frames or its
-// frame rate is not positive.
-fap::FapStream load_fap_stream(const std::string& path);
+// Reads an animation file of any known format for playing (a FAP file or a
+// capture CSV, expression/capture.h; `data` holds the AU and ARKit tables);
+// InputError when it has no frames or its frame rate is not positive.
+fap::FapStream load_fap_stream(const std::string& path, const std::string& data = EMOFACE_DATA_DIR);
 
 // "auto" | "cpu" | "cuda"; InputError otherwise.
 morph::Backend parse_backend(const std::string& text, const std::string& command);
