@@ -12,6 +12,7 @@
 #include "clamp_warning.h"
 #include "command.h"
 #include "emoface/common/error.h"
+#include "emoface/expression/capture.h"
 #include "emoface/expression/face_state.h"
 #include "emoface/fap/fap_io.h"
 
@@ -214,10 +215,10 @@ nlohmann::json to_json(const std::string& path, const FapStream& s) {
 
 void add_info_command(CLI::App& root) {
     auto* sub = root.add_subcommand(
-        "info", "Summarise FAP files: version, name, fps, frames, duration, moving FAPs, FAP 1/2 use, warnings");
+        "info", "Summarise animation files (FAP, OpenFace, Live Link Face or MediaPipe CSV): version, name, fps, frames, duration, moving FAPs, FAP 1/2 use, warnings");
     auto files = std::make_shared<std::vector<std::string>>();
     auto json = std::make_shared<bool>(false);
-    sub->add_option("files", *files, "FAP files")->required();
+    sub->add_option("files", *files, "Animation files: FAP or capture CSV")->required();
     sub->add_flag("--json", *json, "Print a JSON array, one object per file");
     auto data = std::make_shared<std::string>(EMOFACE_DATA_DIR);
     auto frame = std::make_shared<int>(-1);
@@ -232,7 +233,8 @@ void add_info_command(CLI::App& root) {
         nlohmann::json all = nlohmann::json::array();
         for (const std::string& path : *files) {
             try {
-                const FapStream s = read_fap_file(path);
+                const auto animation = emoface::expression::read_animation_file(path, *data);
+                const FapStream& s = animation.stream;
                 if (*frame >= 0 && std::size_t(*frame) >= s.frames.size())
                     throw emoface::InputError(fmt::format("info: {}: --frame {} is past its {} frames", path, *frame,
                                                           s.frames.size()));
@@ -242,6 +244,7 @@ void add_info_command(CLI::App& root) {
                 const std::string which = *frame >= 0 ? fmt::format("frame {}", *frame) : "peak";
                 if (*json) {
                     nlohmann::json j = to_json(path, s);
+                    j["format"] = emoface::expression::animation_format_name(animation.format);
                     nlohmann::json a = nlohmann::json::object();
                     for (int n = 1; n < emoface::expression::kAuNumberLimit; ++n) {
                         if (aus.left[n] >= kShownAuIntensity) a[fmt::format("AU{}L", n)] = aus.left[n];
@@ -251,6 +254,9 @@ void add_info_command(CLI::App& root) {
                     all.push_back(j);
                 } else {
                     print_text(path, s);
+                    if (animation.format != emoface::expression::AnimationFormat::Fap)
+                        fmt::print("  format    {} (resampled at a constant frame rate)\n",
+                                   emoface::expression::animation_format_name(animation.format));
                     fmt::print("  AUs       {} ({}; {} and above)\n", emoface::apps::au_label(aus), which,
                                kShownAuIntensity);
                 }
