@@ -10,6 +10,7 @@
 
 #include "emoface/common/constants.h"
 #include "emoface/common/error.h"
+#include "emoface/common/parallel.h"
 #include "emoface/fap/feature_points.h"
 #include "emoface/fap/fapu.h"
 #include "geodesic.h"
@@ -164,6 +165,7 @@ FaceRig::FaceRig(const Face& face, const RigOptions& options) {
     build_jaw(face);
     build_eyes(face);
     build_head(face);
+    build_kernel_arrays();
 
     for (int f = 1; f <= fap::kFapCount; ++f) {
         std::string& why = no_effect_[f - 1];
@@ -596,7 +598,216 @@ void FaceRig::point_displacements(const FapValues& faps, std::array<std::array<d
     }
 }
 
-void FaceRig::deform(const FapValues& given, DeformedFace& out) const {
+void FaceRig::build_kernel_arrays() {
+    const int n = static_cast<int>(neutral_.size());
+    if (system_held_.size() > std::size_t(rig_kernel::kMaxSystem) || lid_fps_.size() > std::size_t(rig_kernel::kMaxLidFps) ||
+        eyes_.size() > std::size_t(rig_kernel::kMaxEyes))
+        fail<InputError>("expression: rig: expected at most {} point-field entries, {} lid feature points and {} eyeballs, "
+                         "found {}, {} and {}",
+                         rig_kernel::kMaxSystem, rig_kernel::kMaxLidFps, rig_kernel::kMaxEyes, system_held_.size(),
+                         lid_fps_.size(), eyes_.size());
+    KernelArrays& k = kernel_;
+    // Per-vertex CSR of a list of (vertex, entry), keeping the list's order.
+    auto csr = [n](const auto& list, std::vector<int>& start, auto& entries, auto entry_of) {
+        start.assign(std::size_t(n) + 1, 0);
+        for (const auto& e : list) ++start[std::size_t(e.vertex) + 1];
+        for (int v = 0; v < n; ++v) start[std::size_t(v) + 1] += start[std::size_t(v)];
+        std::vector<int> fill(start.begin(), start.end() - 1);
+        entries.resize(list.size());
+        for (const auto& e : list) entries[std::size_t(fill[std::size_t(e.vertex)]++)] = entry_of(e);
+    };
+    csr(lid_weights_, k.lid_start, k.lid_weights, [](const LidWeight& w) { return RigLidWeight{w.lid, w.weight}; });
+    csr(lid_vertices_, k.slide_start, k.slides,
+        [](const LidVertex& l) { return RigSlide{l.eye, l.min_radius, l.shell_radius, l.follow}; });
+    k.lash_anchor.assign(std::size_t(n), -1);
+    k.lash_eye.assign(std::size_t(n), 0);
+    for (const LashVertex& l : lash_vertices_) {  // a vertex listed twice rides on the last anchor, as before
+        k.lash_anchor[std::size_t(l.vertex)] = l.anchor;
+        k.lash_eye[std::size_t(l.vertex)] = l.eye;
+    }
+    k.jaw_weight.assign(std::size_t(n), 0.0f);
+    if (has_jaw_)
+        for (int v : jaw_vertices_) k.jaw_weight[std::size_t(v)] = jaw_weight_[std::size_t(v)];
+    k.eye_of.assign(std::size_t(n), -1);
+    k.eye_polar.assign(std::size_t(n), 0.0f);
+    k.eye_azimuth.assign(std::size_t(n), 0.0f);
+    for (std::size_t e = 0; e < eyes_.size(); ++e)
+        for (int i = 0; i < eyes_[e].count; ++i) {
+            const auto v = std::size_t(eyes_[e].first + i);
+            k.eye_of[v] = int(e);
+            k.eye_polar[v] = eyes_[e].polar[std::size_t(i)];
+            k.eye_azimuth[v] = eyes_[e].azimuth[std::size_t(i)];
+        }
+}
+
+RigView FaceRig::view() const {
+    RigView r;
+    r.vertex_count = static_cast<int>(neutral_.size());
+    static_assert(sizeof(TriMesh::Point) == 3 * sizeof(float), "points are 3 packed floats");
+    r.neutral = reinterpret_cast<const float*>(neutral_.data());
+    r.influence_start = influence_start_.data();
+    r.influences = weights_.data();
+    r.lid_start = kernel_.lid_start.data();
+    r.lid_weights = kernel_.lid_weights.data();
+    r.slide_start = kernel_.slide_start.data();
+    r.slides = kernel_.slides.data();
+    r.lash_anchor = kernel_.lash_anchor.data();
+    r.lash_eye = kernel_.lash_eye.data();
+    r.jaw_weight = kernel_.jaw_weight.data();
+    r.eye_of = kernel_.eye_of.data();
+    r.eye_polar = kernel_.eye_polar.data();
+    r.eye_azimuth = kernel_.eye_azimuth.data();
+    r.head_weight = head_weight_.data();
+    for (std::size_t e = 0; e < eyes_.size(); ++e)
+        for (int c = 0; c < 3; ++c) r.eye_centre[e][c] = eyes_[e].centre[c];
+    return r;
+}
+
+RigFrame FaceRig::frame(const FapValues& given) const {
+    const FapValues faps = lip_contours_together(ranges_.clamp(given));
+    RigFrame f;
+    auto copy = [](const glm::dmat3& m, double* out) {
+        for (int c = 0; c < 3; ++c)
+            for (int r = 0; r < 3; ++r) out[3 * c + r] = m[c][r];
+    };
+    auto nonzero = [](const std::array<double, 3>& d) { return d[0] != 0 || d[1] != 0 || d[2] != 0; };
+
+    // Point FAPs and lid FAPs: their feature points' displacements.
+    std::array<std::array<double, 3>, fap::kFeaturePointCount> fp_d;
+    point_displacements(faps, fp_d);
+    for (int k = 0; k < fap::kFeaturePointCount; ++k) {
+        const int j = system_of_fp_[k];
+        if (j < 0 || system_held_[j]) continue;
+        for (int c = 0; c < 3; ++c) f.system_d[j][c] += fp_d[k][c];
+        f.points |= nonzero(fp_d[k]);
+    }
+    for (std::size_t i = 0; i < lid_fps_.size(); ++i) {
+        for (int c = 0; c < 3; ++c) f.lid_d[i][c] = fp_d[lid_fps_[i]][c];
+        f.lids |= nonzero(fp_d[lid_fps_[i]]);
+    }
+
+    // Jaw: rotate about the pivot so that 2.1 drops by FAP 3 x MNS, then
+    // thrust (14) and shift (15).
+    const double open = faps[2], thrust = faps[13], shift = faps[14];
+    if (has_jaw_ && (open != 0 || thrust != 0 || shift != 0)) {
+        const V chin = to_v(fps_[fap::feature_point_index("2.1")].position) - jaw_pivot_;
+        const double drop = open * fapu_.mns;
+        const double a = std::hypot(chin[1], chin[2]);
+        const double phi0 = std::atan2(chin[2], chin[1]);
+        const double angle = a > 0 ? std::acos(std::clamp((chin[1] - drop) / a, -1.0, 1.0)) - phi0 : 0.0;
+        copy(rot_x(angle), f.jaw_r);
+        const auto& i14 = fap::fap_info(14);
+        const auto& i15 = fap::fap_info(15);
+        for (int c = 0; c < 3; ++c) {
+            f.jaw_t[c] = thrust * fapu_.of(i14.unit) * i14.direction[c] + shift * fapu_.of(i15.unit) * i15.direction[c];
+            f.jaw_pivot[c] = jaw_pivot_[c];
+        }
+        f.jaw = true;
+    }
+
+    // Eyeballs.
+    for (std::size_t i = 0; i < eyes_.size(); ++i) {
+        const EyeState& e = eyes_[i];
+        const bool left = e.centre[0] > 0;
+        const double yaw = faps[left ? 22 : 23], pitch = faps[left ? 24 : 25];
+        const double thrust_e = faps[left ? 26 : 27], dilate = faps[left ? 28 : 29];
+        if (yaw == 0 && pitch == 0 && thrust_e == 0 && dilate == 0) continue;
+        RigEyeFrame& ef = f.eyes[i];
+        ef.on = true;
+        ef.dilate = dilate != 0;
+        copy(rot_y(yaw * fapu_.au) * rot_x(pitch * fapu_.au), ef.r);
+        ef.t[2] = thrust_e * fapu_.es;
+        const double sin_p = std::sin(e.pupil_angle) * e.radius;
+        const double iris_r = std::sin(e.iris_angle) * e.radius;
+        const double pupil_r = std::clamp(sin_p + 0.5 * dilate * fapu_.irisd, 0.12 * iris_r, 0.95 * iris_r);
+        ef.new_pupil = std::asin(std::min(pupil_r / e.radius, 1.0));
+        ef.iris_angle = e.iris_angle;
+        ef.pupil_angle = e.pupil_angle;
+    }
+
+    // Head: pitch (48, front down), yaw (49, front to the face's left), roll
+    // (50, top to the face's right), about 7.1.
+    const double hp = faps[47], hy = faps[48], hr = faps[49];
+    if (hp != 0 || hy != 0 || hr != 0) {
+        copy(rot_y(hy * fapu_.au) * (rot_x(hp * fapu_.au) * rot_z(hr * fapu_.au)), f.head_r);
+        for (int c = 0; c < 3; ++c) f.head_pivot[c] = head_pivot_[c];
+        f.head = true;
+    }
+    return f;
+}
+
+namespace {
+
+// The feature points of a frame whose vertex positions `at(v)` gives.
+template <class At>
+fap::FeaturePointPositions feature_points_of(const std::array<FeaturePointLocation, fap::kFeaturePointCount>& fps,
+                                             const RigFrame& f, double es0, const At& at) {
+    fap::FeaturePointPositions out{};
+    glm::dmat3 head(1.0);
+    for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < 3; ++r) head[c][r] = f.head_r[3 * c + r];
+    const V pivot = to_v(std::array<double, 3>{f.head_pivot[0], f.head_pivot[1], f.head_pivot[2]});
+    for (int k = 0; k < fap::kFeaturePointCount; ++k) {
+        const FeaturePointLocation& fp = fps[k];
+        if (!fp.present) {
+            out[k] = {0, 0, 0};
+        } else if (fp.vertex >= 0) {
+            const rig_kernel::P3 p = at(fp.vertex);
+            out[k] = {double(p.x), double(p.y), double(p.z)};
+        } else if (f.head) {
+            // Free points (7.1, 11.5) turn with the head where the skin would.
+            const double w = glm::smoothstep(pivot[1] - 0.9 * es0, pivot[1], fp.position[1]);
+            const V p = to_v(fp.position);
+            const V moved = head * (p - pivot) + pivot;
+            out[k] = to_array(p + (moved - p) * w);
+        } else {
+            out[k] = fp.position;
+        }
+    }
+    return out;
+}
+
+}  // namespace
+
+void FaceRig::deform(const FapValues& faps, DeformedFace& out) const {
+    const RigFrame f = frame(faps);
+    const RigView r = view();
+    out.positions.resize(neutral_.size());
+    TriMesh::Point* pos = out.positions.data();
+    // Chunks of fixed size: the result does not depend on the threads.
+    parallel_for(r.vertex_count, 4096, [&](int begin, int end) {
+        for (int v = begin; v < end; ++v) {
+            const rig_kernel::P3 p = rig_kernel::position(r, f, v);
+            pos[v] = TriMesh::Point(p.x, p.y, p.z);
+        }
+    });
+    out.feature_points = feature_points_of(fps_, f, fapu_.es * 1024.0, [&](int v) {
+        return rig_kernel::P3{pos[v][0], pos[v][1], pos[v][2]};
+    });
+}
+
+fap::FeaturePointPositions FaceRig::feature_points(const RigFrame& f) const {
+    const RigView r = view();
+    return feature_points_of(fps_, f, fapu_.es * 1024.0, [&](int v) { return rig_kernel::position(r, f, v); });
+}
+
+DeformedFace FaceRig::deform(const FapValues& faps) const {
+    DeformedFace out;
+    deform(faps, out);
+    return out;
+}
+
+fap::FeaturePointPositions FaceRig::feature_points(const FapValues& faps) const {
+    // The kernel body at the feature points' vertices: the same positions as
+    // the full deformation's, at a few hundred vertices' cost.
+    return feature_points(frame(faps));
+}
+
+// The oracle: the rig as it ran before the kernel body, stage after stage
+// over the whole mesh on one thread. Kept only so that the tests can hold
+// the kernel body (deform()) to it.
+DeformedFace FaceRig::deform_reference(const FapValues& given) const {
+    DeformedFace out;
     const FapValues faps = lip_contours_together(ranges_.clamp(given));
     const int n = static_cast<int>(neutral_.size());
     out.positions.assign(neutral_.begin(), neutral_.end());
@@ -752,19 +963,9 @@ void FaceRig::deform(const FapValues& given, DeformedFace& out) const {
             out.feature_points[k] = fp.position;
         }
     }
-}
-
-DeformedFace FaceRig::deform(const FapValues& faps) const {
-    DeformedFace out;
-    deform(faps, out);
     return out;
 }
 
-fap::FeaturePointPositions FaceRig::feature_points(const FapValues& faps) const {
-    // The full deformation is cheap enough at face sizes, and one code path
-    // keeps the points and the mesh consistent.
-    return deform(faps).feature_points;
-}
 
 void FaceRig::write_to(const DeformedFace& deformed, TriMesh& mesh) {
     if (deformed.positions.size() != mesh.n_vertices())

@@ -10,40 +10,14 @@
 #include "emoface/common/constants.h"
 #include "emoface/common/error.h"
 #include "emoface/common/parallel.h"
+#include "emoface/render/geometry_kernel.h"
 
 namespace emoface::render {
 namespace {
 
-glm::vec3 to_glm(const OpenMesh::Vec3f& v) { return {v[0], v[1], v[2]}; }
+namespace gk = geometry_kernel;
 
-// The component of v perpendicular to the unit vector n.
-glm::vec3 reject(const glm::vec3& v, const glm::vec3& n) { return v - n * glm::dot(n, v); }
-
-bool usable(const glm::vec3& v, float min_length2) {
-    const float l2 = glm::dot(v, v);
-    return std::isfinite(l2) && l2 > min_length2;
-}
-
-// Any unit vector perpendicular to the unit vector n.
-glm::vec3 any_perpendicular(const glm::vec3& n) {
-    const glm::vec3 axis = std::fabs(n.x) < 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
-    return glm::normalize(glm::cross(glm::cross(n, axis), n));
-}
-
-// A UV triangle whose edges are nearly parallel (sine of their angle below
-// this) has no usable tangent direction: MikkTSpace's "degenerate" faces.
-constexpr float kMinUvSine = 1e-6f;
-constexpr float kMinLength2 = 1e-24f;
-
-// acos to within 7e-5 rad (Abramowitz and Stegun 4.4.45): the angle only
-// weights a corner's share, and std::acos is the loop's largest cost.
-float fast_acos(float x) {
-    x = glm::clamp(x, -1.0f, 1.0f);
-    const float a = std::fabs(x);
-    float r = ((-0.0187293f * a + 0.0742610f) * a - 0.2121144f) * a + 1.5707288f;
-    r *= std::sqrt(1.0f - a);
-    return x < 0 ? kPiF - r : r;
-}
+gk::V3 to_v3(const OpenMesh::Vec3f& v) { return {v[0], v[1], v[2]}; }
 
 }  // namespace
 
@@ -94,94 +68,42 @@ void TangentFrames::compute(const expression::TriMesh& mesh, const std::vector<g
     const auto* points = reinterpret_cast<const OpenMesh::Vec3f*>(mesh.points());
     const auto* normals = reinterpret_cast<const OpenMesh::Vec3f*>(mesh.vertex_normals());
     const std::size_t faces = triangles_.size() / 3;
-    unit_normals_.resize(n);
-    face_t_.resize(faces);
-    face_b_.resize(faces);
-    corner_angle_.resize(faces * 3);
+    face_frames_.resize(faces);
     tangents_.resize(n);
 
     // Large meshes are split over the shared pool; chunks of fixed size keep
     // the work per wake-up large and the result independent of the threads.
-    constexpr std::size_t kChunk = 4096;
-    auto parallel = [](std::size_t count, const std::function<void(std::size_t, std::size_t)>& body) {
-        parallel_for(int(count), int(kChunk), [&](int begin, int end) { body(std::size_t(begin), std::size_t(end)); });
-    };
+    constexpr int kChunk = 4096;
 
-    // Pass 1, per triangle: dp/du, dp/dv (up to a positive factor) and the
-    // corner angles; zero vectors mark faces without a usable frame.
-    parallel(faces, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t f = begin; f < end; ++f) {
-            const int* idx = &triangles_[3 * f];
-            face_t_[f] = face_b_[f] = glm::vec3(0.0f);
-            const glm::vec3 p[3] = {to_glm(points[idx[0]]), to_glm(points[idx[1]]),
-                                    to_glm(points[idx[2]])};
-            const glm::vec2 uv[3] = {uvs[idx[0]], uvs[idx[1]], uvs[idx[2]]};
-            const glm::vec3 e1 = p[1] - p[0], e2 = p[2] - p[0];
-            const glm::vec2 d1 = uv[1] - uv[0], d2 = uv[2] - uv[0];
-            const float det = d1.x * d2.y - d2.x * d1.y;
-            const float uv_scale = std::sqrt(glm::dot(d1, d1) * glm::dot(d2, d2));
-            if (!(std::fabs(det) > kMinUvSine * uv_scale)) continue;  // also rejects NaN UVs
-            const float s = det > 0 ? 1.0f : -1.0f;
-            const glm::vec3 t = (e1 * d2.y - e2 * d1.y) * s;
-            const glm::vec3 b = (e2 * d1.x - e1 * d2.x) * s;
-            if (!usable(t, kMinLength2) || !usable(b, kMinLength2)) continue;
-            glm::vec3 edge[3] = {p[1] - p[0], p[2] - p[1], p[0] - p[2]};
-            bool edges_ok = true;
-            for (auto& e : edge) {
-                const float l2 = glm::dot(e, e);
-                if (!(l2 > kMinLength2)) edges_ok = false;
-                e /= std::sqrt(l2);
-            }
-            if (!edges_ok) continue;  // a zero-length edge: no corner angles
-            face_t_[f] = t;
-            face_b_[f] = b;
-            // Corner c lies between the edge leaving it and the one arriving.
-            for (int c = 0; c < 3; ++c)
-                corner_angle_[3 * f + c] = fast_acos(-glm::dot(edge[c], edge[(c + 2) % 3]));
+    // Pass 1, per triangle: its frame (geometry_kernel::face_frame).
+    parallel_for(int(faces), kChunk, [&](int begin, int end) {
+        for (int f = begin; f < end; ++f) {
+            const int* idx = &triangles_[3 * std::size_t(f)];
+            const gk::V3 p[3] = {to_v3(points[idx[0]]), to_v3(points[idx[1]]), to_v3(points[idx[2]])};
+            const gk::V2 uv[3] = {{uvs[idx[0]].x, uvs[idx[0]].y}, {uvs[idx[1]].x, uvs[idx[1]].y},
+                                  {uvs[idx[2]].x, uvs[idx[2]].y}};
+            face_frames_[std::size_t(f)] = gk::face_frame(p, uv);
         }
     });
 
-    // Pass 2, per vertex: gather its corners, orthogonalise, pick w.
+    // Pass 2, per vertex: gather its corners (geometry_kernel::vertex_tangent).
     std::atomic<std::size_t> fallbacks{0};
-    parallel(n, [&](std::size_t begin, std::size_t end) {
+    parallel_for(int(n), kChunk, [&](int begin, int end) {
         std::size_t local_fallbacks = 0;
-        for (std::size_t v = begin; v < end; ++v) {
-            const glm::vec3 nv = to_glm(normals[v]);
-            const bool has_normal = usable(nv, kMinLength2);
-            const glm::vec3 nn = has_normal ? nv / std::sqrt(glm::dot(nv, nv)) : glm::vec3(0, 0, 1);
-            glm::vec3 t_sum(0.0f), b_sum(0.0f);
-            float w_sum = 0.0f;
-            if (has_normal)
-                for (int k = corner_start_[v]; k < corner_start_[v + 1]; ++k) {
-                    const int corner = corners_[std::size_t(k)];
-                    const std::size_t f = std::size_t(corner) / 3;
-                    glm::vec3 t = reject(face_t_[f], nn), bt = reject(face_b_[f], nn);
-                    const float lt = glm::dot(t, t), lb = glm::dot(bt, bt);
-                    if (!(lt > kMinLength2) || !(lb > kMinLength2)) continue;
-                    t /= std::sqrt(lt);
-                    bt /= std::sqrt(lb);
-                    // Handedness of this corner. Accumulating w*T instead of T
-                    // keeps the tangents of mirrored halves (u runs the other
-                    // way) from cancelling where they meet; the vertex then
-                    // takes the dominant w.
-                    const float w = glm::dot(glm::cross(nn, t), bt) < 0 ? -1.0f : 1.0f;
-                    const float angle = corner_angle_[std::size_t(corner)];
-                    t_sum += angle * w * t;
-                    b_sum += angle * bt;
-                    w_sum += angle * w;
-                }
-            const float w = w_sum < 0 ? -1.0f : 1.0f;
-            glm::vec3 t = reject(t_sum, nn);
-            if (usable(t, kMinLength2)) {
-                t = w * glm::normalize(t);
-            } else {
-                ++local_fallbacks;
-                const glm::vec3 b = reject(b_sum, nn);
-                // B = w cross(N, T) for an orthonormal frame, hence T = w cross(B, N).
-                t = usable(b, kMinLength2) ? w * glm::normalize(glm::cross(b, nn))
-                                           : any_perpendicular(nn);
-            }
-            tangents_[v] = glm::vec4(t, usable(t, kMinLength2) ? w : 1.0f);
+        for (int v = begin; v < end; ++v) {
+            const int first = corner_start_[std::size_t(v)];
+            auto corner = [&](int k, gk::V3& t, gk::V3& b, float& angle) {
+                const int c = corners_[std::size_t(first + k)];
+                const gk::FaceFrame& f = face_frames_[std::size_t(c / 3)];
+                t = f.t;
+                b = f.b;
+                angle = f.angle[c % 3];
+            };
+            bool fallback = false;
+            const gk::V4 t = gk::vertex_tangent(to_v3(normals[v]), corner_start_[std::size_t(v) + 1] - first, corner,
+                                                &fallback);
+            tangents_[std::size_t(v)] = glm::vec4(t.x, t.y, t.z, t.w);
+            local_fallbacks += fallback;
         }
         fallbacks += local_fallbacks;
     });

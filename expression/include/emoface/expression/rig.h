@@ -23,8 +23,11 @@
 //  - FAPs 23-28 rotate and thrust the eyeballs about their centres, 29/30
 //    grow the pupils by sliding the iris vertices over the eyeball;
 //  - FAPs 48-50 rotate the head about 7.1 (head pivot), fading down the neck.
-// Per frame the cost is a weighted sum over the precomputed influences plus
-// the rigid transforms: no allocation once `out` has its size.
+// Per frame the host turns the FAPs into a RigFrame (a few hundred doubles:
+// frame()), and each vertex's position is the one kernel body of
+// rig_kernel.h over the precomputed flat arrays (view()): on all cores here,
+// on the GPU in render's CUDA geometry driver. No allocation once `out` has
+// its size.
 #include <array>
 #include <cstdint>
 #include <string>
@@ -34,6 +37,7 @@
 
 #include "emoface/expression/face.h"
 #include "emoface/expression/fap_values.h"
+#include "emoface/expression/rig_kernel.h"
 #include "emoface/fap/fap_table.h"
 
 namespace emoface::expression {
@@ -80,9 +84,21 @@ public:
 
     void deform(const FapValues& faps, DeformedFace& out) const;
     DeformedFace deform(const FapValues& faps) const;
+    // The rig as it ran before the kernel body, one stage after the other
+    // over the whole mesh, on one thread: the oracle the kernel's tests
+    // compare with (rig_reference.cpp).
+    DeformedFace deform_reference(const FapValues& faps) const;
 
-    // Only the feature points, without touching the mesh: cheap.
+    // Only the feature points: the kernel body at their vertices alone.
     fap::FeaturePointPositions feature_points(const FapValues& faps) const;
+
+    // The frame's parameters for the kernel body (FAPs clamped, lip
+    // contours together, point displacements, rigid transforms).
+    RigFrame frame(const FapValues& faps) const;
+    // The face's flat arrays, in host memory (valid while the rig lives).
+    RigView view() const;
+    // The feature points for a frame, from its parameters.
+    fap::FeaturePointPositions feature_points(const RigFrame& frame) const;
 
     // Writes `deformed` into `mesh` (a copy of the face's mesh) and
     // recomputes its normals.
@@ -103,10 +119,6 @@ public:
     float jaw_weight(int vertex) const { return jaw_weight_.at(vertex); }
 
 private:
-    struct Influence {
-        std::uint16_t system;  // index into system_fps_
-        float weight;
-    };
     struct EyeState {
         int first = 0, count = 0;
         glm::dvec3 centre{0.0};
@@ -143,7 +155,7 @@ private:
     std::vector<double> system_radius_;     // kernel radius per system entry
     std::vector<bool> system_held_;         // entries (and eyelid margins) the point field holds still
     std::vector<int> influence_start_;      // size vertex_count + 1
-    std::vector<Influence> weights_;
+    std::vector<RigInfluence> weights_;  // system: index into system_fps_
     std::array<int, fap::kFeaturePointCount> system_of_fp_{};    // -1 when not in the system
 
     // Jaw.
@@ -172,6 +184,17 @@ private:
 
     std::array<std::string, fap::kFapCount> no_effect_{};
     FapRanges ranges_;
+
+    // The kernel body's flat arrays (rig_kernel.h), from the above.
+    void build_kernel_arrays();
+    struct KernelArrays {
+        std::vector<int> lid_start;
+        std::vector<RigLidWeight> lid_weights;
+        std::vector<int> slide_start;
+        std::vector<RigSlide> slides;
+        std::vector<int> lash_anchor, lash_eye, eye_of;
+        std::vector<float> jaw_weight, eye_polar, eye_azimuth;
+    } kernel_;
 };
 
 }  // namespace emoface::expression

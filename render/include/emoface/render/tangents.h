@@ -5,7 +5,8 @@
 // orthogonalised against the normal (Gram-Schmidt); w holds the handedness, so
 // the shader rebuilds the bitangent as w * cross(N, T).
 //
-// The frames are recomputed every frame on the deformed mesh: the projective
+// The arithmetic is geometry_kernel.h's, which the GPU geometry driver runs
+// too. The frames are recomputed every frame on the deformed mesh: the projective
 // layout's wrinkle UVs change every frame, and with the anchored layout's
 // fixed UVs the surface still bends (DESIGN.md "One frame"). TangentFrames
 // keeps its buffers between calls and does not allocate once the vertex
@@ -20,6 +21,7 @@
 #include <glm/vec4.hpp>
 
 #include "emoface/expression/mesh.h"
+#include "emoface/render/geometry_kernel.h"
 
 namespace emoface::render {
 
@@ -61,10 +63,9 @@ private:
     std::vector<int> triangles_;
     std::vector<int> corner_start_, corners_;
     std::size_t topology_vertices_ = 0, topology_faces_ = 0;
-    // Per frame: unit normals, per-face dp/du and dp/dv (zero when the face
-    // is degenerate) and per-corner angles.
-    std::vector<glm::vec3> unit_normals_, face_t_, face_b_;
-    std::vector<float> corner_angle_;
+    // Per frame: each face's dp/du, dp/dv (zero when the face is
+    // degenerate) and corner angles.
+    std::vector<geometry_kernel::FaceFrame> face_frames_;
     std::vector<glm::vec4> tangents_;
     std::vector<glm::vec2> uv_scratch_;
     std::size_t fallback_count_ = 0;
