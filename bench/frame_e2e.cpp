@@ -1,6 +1,8 @@
-// bench/frame_e2e: the whole frame on the GPU machine (issue 6). Per frame:
-// sample the FAP stream, rig, tangents, layout, morph of the K = 7 key maps
-// into the interop texture, bump-mapped draw, fence. Prints the thesis's
+// bench/frame_e2e: the whole frame on the GPU machine (issues 6, 13). Per
+// frame: sample the FAP stream, layout, morph of the key maps into the
+// interop texture, the geometry (rig, normals, wrinkle UVs, tangent frames:
+// on the GPU into the vertex buffers with --geometry gpu, else on the CPU and
+// uploaded), bump-mapped draw, fence. Prints the thesis's
 // stage table (allocate, upload, per-frame morph, bump-mapped draw, whole
 // frame) as medians, and compares one frame with a reference render (the same
 // frame drawn on the CPU backend and llvmpipe, saved with --save), printing
@@ -27,6 +29,7 @@
 #include "emoface/expression/default_face.h"
 #include "emoface/fap/fap_io.h"
 #include "emoface/render/face_assets.h"
+#include "emoface/render/face_geometry.h"
 #include "emoface/render/face_scene.h"
 #include "emoface/render/image_diff.h"
 #include "emoface/render/platform.h"
@@ -88,7 +91,7 @@ void fence() {
 int main(int argc, char** argv) {
     CLI::App app{"emoface end-to-end frame benchmark (FAP sample to fenced draw)"};
     std::string data_dir = EMOFACE_DATA_DIR, fap_path, save, compare, backend_name = "auto";
-    std::string frames_name = "mesh", accuracy = "exact";
+    std::string frames_name = "mesh", accuracy = "exact", geometry = "auto";
     int frames = 500, warmup = 30, map_size = 2048, width = 1920, height = 1080, samples = 4;
     int check_frame = 25;
     double face_scale = 1.0, min_psnr = 30.0;
@@ -108,6 +111,10 @@ int main(int argc, char** argv) {
     app.add_option("--tangents", frames_name,
                    "wrinkle UVs and tangent frames: mesh (CPU, uploaded) or shader (closed form)")
         ->check(CLI::IsMember({"mesh", "shader"}));
+    app.add_option("--geometry", geometry,
+                   "rig, normals and tangent frames: gpu (CUDA, into the vertex buffers), cpu, or auto "
+                   "(gpu with a CUDA device and morph backend)")
+        ->check(CLI::IsMember({"auto", "gpu", "cpu"}));
     app.add_option("--accuracy", accuracy, "morph accuracy: exact or fast")
         ->check(CLI::IsMember({"exact", "fast"}));
     app.add_option("--check-frame", check_frame, "stream frame saved or compared");
@@ -142,6 +149,8 @@ int main(int argc, char** argv) {
         so.backend = backend;
         so.frames = frames_name == "shader" ? render::WrinkleFrames::Shader : render::WrinkleFrames::Mesh;
         so.morph.accuracy = accuracy == "fast" ? morph::Accuracy::Fast : morph::Accuracy::Exact;
+        so.gpu_geometry = geometry == "gpu" || (geometry == "auto" && backend != morph::Backend::Cpu &&
+                                                 render::cuda_geometry_available());
         t = Clock::now();
         render::FaceScene scene(platform, face, *assets->rig, assets->keys, assets->lines, so);
         const double scene_ms = ms(Clock::now() - t);
@@ -152,8 +161,11 @@ int main(int argc, char** argv) {
                     morph::to_string(scene.morpher().backend()), accuracy.c_str(),
                     morph::cuda_device_description().c_str(), scene.key_count(), map_size,
                     map_size, assets->lines.size(), scene.uses_interop() ? "yes" : "no");
-        std::printf("  wrinkle UVs and tangent frames: %s\n",
-                    frames_name == "shader" ? "vertex shader (closed form)" : "CPU (TangentFrames), uploaded");
+        std::printf("  rig, normals: %s; wrinkle UVs and tangent frames: %s\n",
+                    scene.uses_gpu_geometry() ? "GPU (CUDA into the vertex buffers)" : "CPU (all cores), uploaded",
+                    frames_name == "shader"       ? "vertex shader (closed form)"
+                    : scene.uses_gpu_geometry() ? "GPU (CUDA into the vertex buffers)"
+                                                : "CPU (TangentFrames), uploaded");
         std::printf("  face: %zu vertices, %zu triangles; frame %dx%d, %d samples; FAP %s, %zu frames at %g fps\n",
                     face.mesh.n_vertices(), face.mesh.n_faces(), width, height, platform.samples(),
                     fap_path.c_str(), stream.frames.size(), stream.fps);
@@ -203,30 +215,45 @@ int main(int argc, char** argv) {
         }
 
         // Pass 1: whole frames, nothing but the final fence synchronises.
-        Series whole;
+        // The host's share: the frame's parameters (update) and everything
+        // up to the draw's submission; the fence's wait is the GPU's.
+        Series whole, host_update, host_submit;
         for (long i = 0; i < warmup + frames; ++i) {
             const auto t0 = Clock::now();
             const expression::FaceState st = state_of(frame_at(i));
-            scene.update(st.faps, render::key_weights(assets->keys, st));
+            const std::vector<float> w = render::key_weights(assets->keys, st);
+            const auto t1 = Clock::now();
+            scene.update(st.faps, w);
+            const auto t2 = Clock::now();
             platform.begin_frame();
             scene.draw(draw);
             platform.end_frame();
+            const auto t3 = Clock::now();
             fence();
-            if (i >= warmup) whole.add(ms(Clock::now() - t0));
+            if (i >= warmup) {
+                whole.add(ms(Clock::now() - t0));
+                host_update.add(ms(t2 - t1));
+                host_submit.add(ms(t3 - t0));
+            }
         }
 
         // Pass 2: the same frames with each stage timed on its own (host
         // clocks, CUDA events around map + morph + unmap, a GL timer query
         // around the draw), so the stages' sum exceeds pass 1's frame a little.
-        Series sample_s, rig_s, layout_s, uv_s, tangents_s, upload_s, map_s, unmap_s, morph_s, draw_s;
+        Series sample_s, rig_s, layout_s, uv_s, tangents_s, upload_s, map_s, unmap_s, morph_s, draw_s, geometry_gpu_s;
         GLuint query = 0;
         glGenQueries(1, &query);
 #if EMOFACE_BENCH_CUDA
-        cudaEvent_t ev0 = nullptr, ev1 = nullptr;
+        cudaEvent_t ev0 = nullptr, ev1 = nullptr, ev2 = nullptr, ev3 = nullptr;
         const bool cuda = scene.uses_interop();
         if (cuda) {
             cudaEventCreate(&ev0);
             cudaEventCreate(&ev1);
+        }
+        const auto geometry_stream = static_cast<cudaStream_t>(scene.geometry_stream());
+        if (geometry_stream) {
+            cudaEventCreate(&ev2);
+            cudaEventCreate(&ev3);
         }
 #endif
         for (long i = 0; i < warmup + frames; ++i) {
@@ -235,8 +262,21 @@ int main(int argc, char** argv) {
             const expression::FapValues& faps = state.faps;
             const std::vector<float> w = render::key_weights(assets->keys, state);
             const double sample_ms = ms(Clock::now() - t0);
+#if EMOFACE_BENCH_CUDA
+            if (geometry_stream) cudaEventRecord(ev2, geometry_stream);
+#endif
             scene.update_geometry(faps);
             const render::FrameStageTimes st = scene.last_times();
+            double geometry_gpu_ms = 0;
+#if EMOFACE_BENCH_CUDA
+            if (geometry_stream) {
+                cudaEventRecord(ev3, geometry_stream);
+                cudaEventSynchronize(ev3);
+                float e = 0;
+                cudaEventElapsedTime(&e, ev2, ev3);
+                geometry_gpu_ms = e;
+            }
+#endif
             double map_ms = 0, unmap_ms = 0, morph_ms = 0;
 #if EMOFACE_BENCH_CUDA
             if (cuda) {
@@ -272,6 +312,7 @@ int main(int argc, char** argv) {
             glGetQueryObjectui64v(query, GL_QUERY_RESULT, &ns);
             if (i < warmup) continue;
             sample_s.add(sample_ms);
+            geometry_gpu_s.add(geometry_gpu_ms);
             rig_s.add(st.rig_ms);
             layout_s.add(st.layout_ms);
             uv_s.add(st.uv_ms);
@@ -294,9 +335,21 @@ int main(int argc, char** argv) {
         row("per-frame morph (map + kernel + unmap)", morph_s.median(), morph_s.pct(0.9));
         row("bump-mapped draw (GL time, + MSAA resolve)", draw_s.median(), draw_s.pct(0.9));
         row("whole frame (sample .. fence)", whole.median(), whole.pct(0.9));
+        std::printf("\nissue 13: host, GPU compute, draw, frame (ms)\n");
+        row("host: update (parameters, layout, launches)", host_update.median(), host_update.pct(0.9));
+        row("host: sample .. draw submitted", host_submit.median(), host_submit.pct(0.9));
+        row("GPU: rig + normals + UVs + tangents", geometry_gpu_s.median(), geometry_gpu_s.pct(0.9));
+        row("GPU: morph (map + kernel + unmap)", morph_s.median(), morph_s.pct(0.9));
+        row("GPU: compute (geometry + morph, medians)", geometry_gpu_s.median() + morph_s.median(),
+            geometry_gpu_s.pct(0.9) + morph_s.pct(0.9));
+        row("draw (GL time, + MSAA resolve)", draw_s.median(), draw_s.pct(0.9));
+        row("whole frame (sample .. fence)", whole.median(), whole.pct(0.9));
+        std::printf("  whole frame - draw: %.3f ms (medians)\n", whole.median() - draw_s.median());
         std::printf("\nper-frame stages in detail (ms)\n");
         row("sample the FAP stream + face state (mix)", sample_s.median(), sample_s.pct(0.9));
-        row("rig (FAPs to mesh + normals)", rig_s.median(), rig_s.pct(0.9));
+        row(scene.uses_gpu_geometry() ? "geometry on the GPU: host (parameters, map, launch, unmap)"
+                                      : "rig (FAPs to mesh + normals)",
+            rig_s.median(), rig_s.pct(0.9));
         row("layout L* (feature points projected)", layout_s.median(), layout_s.pct(0.9));
         row("wrinkle UVs (vertices projected)", uv_s.median(), uv_s.pct(0.9));
         row("tangent frames", tangents_s.median(), tangents_s.pct(0.9));
@@ -309,6 +362,10 @@ int main(int argc, char** argv) {
         if (cuda) {
             cudaEventDestroy(ev0);
             cudaEventDestroy(ev1);
+        }
+        if (geometry_stream) {
+            cudaEventDestroy(ev2);
+            cudaEventDestroy(ev3);
         }
 #endif
     } catch (const std::exception& e) {

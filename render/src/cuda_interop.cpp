@@ -85,3 +85,58 @@ void WrinkleTexture::unregister_cuda() noexcept {
 }
 
 }  // namespace emoface::render
+
+// GL vertex buffers written by CUDA kernels (face_geometry.h): registered
+// once, write-discard (the kernels rewrite every vertex each frame), mapped
+// all in one call per frame.
+#include "emoface/render/face_geometry.h"
+
+namespace emoface::render {
+
+GlBufferInterop::GlBufferInterop(const std::vector<unsigned>& gl_buffers) {
+    if (!cuda_interop_available()) fail<EnvironmentError>("render: CUDA-GL interop: no CUDA device");
+    for (unsigned b : gl_buffers) {
+        cudaGraphicsResource_t r = nullptr;
+        const cudaError_t e = cudaGraphicsGLRegisterBuffer(&r, b, cudaGraphicsRegisterFlagsWriteDiscard);
+        if (e != cudaSuccess) {
+            for (void* done : resources_) cudaGraphicsUnregisterResource(static_cast<cudaGraphicsResource_t>(done));
+            check_cuda(e, "cudaGraphicsGLRegisterBuffer (is the GL context on the CUDA device?)");
+        }
+        resources_.push_back(r);
+    }
+}
+
+GlBufferInterop::~GlBufferInterop() {
+    try {
+        unmap(nullptr);
+    } catch (...) {
+    }
+    for (void* r : resources_) cudaGraphicsUnregisterResource(static_cast<cudaGraphicsResource_t>(r));
+}
+
+std::vector<float*> GlBufferInterop::map(void* stream) {
+    if (mapped_) fail("render: GlBufferInterop::map(): already mapped");
+    auto* resources = reinterpret_cast<cudaGraphicsResource_t*>(resources_.data());
+    const auto s = static_cast<cudaStream_t>(stream);
+    check_cuda(cudaGraphicsMapResources(int(resources_.size()), resources, s), "cudaGraphicsMapResources (buffers)");
+    mapped_ = true;
+    std::vector<float*> out;
+    for (auto* r : resources_) {
+        void* p = nullptr;
+        std::size_t size = 0;
+        check_cuda(cudaGraphicsResourceGetMappedPointer(&p, &size, static_cast<cudaGraphicsResource_t>(r)),
+                   "cudaGraphicsResourceGetMappedPointer");
+        out.push_back(static_cast<float*>(p));
+    }
+    return out;
+}
+
+void GlBufferInterop::unmap(void* stream) {
+    if (!mapped_) return;
+    mapped_ = false;
+    auto* resources = reinterpret_cast<cudaGraphicsResource_t*>(resources_.data());
+    check_cuda(cudaGraphicsUnmapResources(int(resources_.size()), resources, static_cast<cudaStream_t>(stream)),
+               "cudaGraphicsUnmapResources (buffers)");
+}
+
+}  // namespace emoface::render

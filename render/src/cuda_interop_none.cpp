@@ -21,3 +21,16 @@ void WrinkleTexture::unmap(void*) {}
 void WrinkleTexture::unregister_cuda() noexcept {}
 
 }  // namespace emoface::render
+
+#include "emoface/render/face_geometry.h"
+
+namespace emoface::render {
+
+GlBufferInterop::GlBufferInterop(const std::vector<unsigned>&) {
+    fail<EnvironmentError>("render: CUDA-GL interop: this build has no CUDA (nvcc was not found)");
+}
+GlBufferInterop::~GlBufferInterop() = default;
+std::vector<float*> GlBufferInterop::map(void*) { return {}; }
+void GlBufferInterop::unmap(void*) {}
+
+}  // namespace emoface::render

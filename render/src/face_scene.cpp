@@ -10,6 +10,7 @@
 
 #include "emoface/common/error.h"
 #include "emoface/common/timing.h"
+#include "emoface/render/face_geometry.h"
 #include "emoface/render/tangents.h"
 #include "emoface/render/wrinkle_morph.h"
 
@@ -234,6 +235,29 @@ FaceScene::FaceScene(Platform& platform, const expression::Face& face,
             renderer_->update_mesh(part.id, part.mesh, part.wrinkle_uvs, part.fixed_tangents);
     }
 
+    if (options.gpu_geometry) {
+        // The parts' vertex buffers, written by the GPU from now on.
+        std::vector<GeometryPart> geometry_parts;
+        std::vector<unsigned> buffers;
+        for (Part& part : parts_) {
+            if (part.id < 0) continue;
+            GeometryPart gp;
+            gp.full_index = part.full_index;
+            for (const auto fh : part.mesh.faces())
+                for (const auto vh : part.mesh.fv_range(fh)) gp.triangles.push_back(vh.idx());
+            gp.frames = part.wrinkles && frames_ == WrinkleFrames::Mesh;
+            if (gp.frames && layout_kind_ == WrinkleLayout::Anchored) gp.fixed_uvs = part.wrinkle_uvs;
+            const auto b = renderer_->vertex_buffers(part.id);
+            buffers.push_back(b[0]);
+            if (gp.frames) buffers.push_back(b[1]);
+            geometry_parts.push_back(std::move(gp));
+        }
+        geometry_ = std::make_unique<FaceGeometry>(rig_, mesh_, std::move(geometry_parts),
+                                                   std::array<float, 4>{box_.min.x, box_.min.y, box_.max.x, box_.max.y});
+        cuda_geometry_ = std::make_unique<CudaGeometry>(*geometry_);
+        geometry_buffers_ = std::make_unique<GlBufferInterop>(buffers);
+    }
+
     // Start at the neutral pose with the first key alone.
     expression::FapValues neutral{};
     std::vector<float> weights(keys.size(), 0.0f);
@@ -243,6 +267,8 @@ FaceScene::FaceScene(Platform& platform, const expression::Face& face,
 
 FaceScene::~FaceScene() {
     platform_.make_current();
+    geometry_buffers_.reset();
+    cuda_geometry_.reset();
     wrinkle_morph_.reset();
     texture_.reset();
     renderer_.reset();
@@ -277,8 +303,32 @@ void FaceScene::update_geometry(const expression::FapValues& faps) {
     deform(faps, /*layout_from_mesh=*/true);
 }
 
+void* FaceScene::geometry_stream() const { return cuda_geometry_ ? cuda_geometry_->stream() : nullptr; }
+
+void FaceScene::deform_on_gpu(const expression::FapValues& faps, bool layout_from_mesh) {
+    const auto t = Clock::now();
+    const expression::RigFrame frame = rig_.frame(faps);
+    if (layout_from_mesh && layout_kind_ == WrinkleLayout::Projective) {
+        layout_ = layout_of(rig_.feature_points(frame), present_points(face_), box_);
+        target_ = to_morph_layout(expression::layout_segments(lines_, layout_));
+    }
+    void* stream = cuda_geometry_->stream();
+    const std::vector<float*> mapped = geometry_buffers_->map(stream);
+    std::vector<float*> shape, frames;
+    std::size_t next = 0;
+    for (int p = 0; p < geometry_->part_count(); ++p) {
+        shape.push_back(mapped[next++]);
+        frames.push_back(geometry_->part(p).frames ? mapped[next++] : nullptr);
+    }
+    cuda_geometry_->run(frame, shape, frames);
+    geometry_buffers_->unmap(stream);
+    times_.rig_ms = ms_since(t);  // host time: parameters, map, launches, unmap
+    times_.uv_ms = times_.tangents_ms = times_.upload_ms = 0.0;
+}
+
 void FaceScene::deform(const expression::FapValues& faps, bool layout_from_mesh) {
     platform_.make_current();
+    if (cuda_geometry_) return deform_on_gpu(faps, layout_from_mesh);
     auto t = Clock::now();
     rig_.deform(faps, deformed_);
     expression::FaceRig::write_to(deformed_, mesh_);

@@ -315,6 +315,11 @@ Renderer::~Renderer() {
 
 std::size_t Renderer::mesh_count() const { return impl_->meshes.size(); }
 
+std::array<unsigned, 2> Renderer::vertex_buffers(MeshId id) const {
+    const Impl::Mesh& m = impl_->mesh(id);
+    return {m.shape_vbo, m.frame_vbo};
+}
+
 Renderer::MeshId Renderer::add_mesh(const expression::TriMesh& mesh, const Material& material) {
     impl_->platform.make_current();
     if (mesh.n_vertices() == 0 || mesh.n_faces() == 0)

@@ -102,6 +102,12 @@ struct FaceSceneOptions {
     Material skin{};  // base_texture: the face's base colour unless set
     Material eyes{};
     Material mouth{};
+    // The rig, vertex normals, wrinkle UVs and tangent frames on the GPU
+    // (face_geometry.h: the CPU path's kernel bodies), written straight
+    // into the vertex buffers through CUDA-GL interop; per frame only the
+    // rig's parameters leave the host. Needs a CUDA device sharing the GL
+    // context; mesh() then stays at the neutral pose.
+    bool gpu_geometry = false;
     FaceSceneOptions();
 };
 
@@ -112,6 +118,9 @@ struct FrameStageTimes {
 };
 
 class WrinkleMorph;
+class FaceGeometry;
+class CudaGeometry;
+class GlBufferInterop;
 
 class FaceScene {
 public:
@@ -151,6 +160,9 @@ public:
 
     const FrameStageTimes& last_times() const { return times_; }
     bool uses_interop() const;
+    bool uses_gpu_geometry() const { return cuda_geometry_ != nullptr; }
+    // The CUDA stream the GPU geometry runs on (null without it).
+    void* geometry_stream() const;
     int key_count() const;
     const expression::TriMesh& mesh() const { return mesh_; }
     const expression::FeatureLayout& layout() const { return layout_; }
@@ -167,6 +179,7 @@ private:
     // Rig, wrinkle UVs, tangents, upload; and L* from the deformed feature
     // points when asked (projective layout; the anchored L* never moves).
     void deform(const expression::FapValues& faps, bool layout_from_mesh);
+    void deform_on_gpu(const expression::FapValues& faps, bool layout_from_mesh);
 
     Platform& platform_;
     const expression::Face& face_;
@@ -186,6 +199,9 @@ private:
     morph::MorphParams params_;
     WrinkleFrames frames_;
     FrameStageTimes times_;
+    std::unique_ptr<FaceGeometry> geometry_;
+    std::unique_ptr<CudaGeometry> cuda_geometry_;
+    std::unique_ptr<GlBufferInterop> geometry_buffers_;
 };
 
 }  // namespace emoface::render

@@ -141,6 +141,10 @@ public:
     void update_shape(MeshId id, const expression::TriMesh& mesh);
 
     void set_material(MeshId id, const Material& material);
+    // The GL buffers of a mesh's per-frame vertex data, {shape, frame}: shape
+    // 6 floats per vertex (position, normal), frame 6 (tangent xyzw, wrinkle
+    // UV); for a writer on the GPU (face_geometry.h) instead of update_mesh().
+    std::array<unsigned, 2> vertex_buffers(MeshId id) const;
     std::size_t mesh_count() const;
 
     // Draws every mesh. `wrinkle_map` null, or options.wrinkles false: flat

@@ -1,0 +1,162 @@
+// CudaGeometry: FaceGeometry's kernel bodies on the GPU. Two launches per
+// frame on its own stream: the rig over the full mesh into a device
+// scratch of positions, then one thread per part vertex for its normal,
+// wrinkle UV and tangent frame, written where the caller says (the mapped GL
+// vertex buffers). The frame's parameters travel as the first launch's
+// argument: no copy, no wait.
+#include <cuda_runtime.h>
+
+#include <vector>
+
+#include "emoface/common/error.h"
+#include "emoface/render/face_geometry.h"
+
+namespace emoface::render {
+namespace {
+
+constexpr int kMaxParts = 8;
+
+void check(cudaError_t e, const char* what) {
+    if (e != cudaSuccess)
+        fail<InternalError>("render: CUDA geometry: {}: {} ({})", what, cudaGetErrorName(e), cudaGetErrorString(e));
+}
+
+struct PartOutputs {
+    float* shape[kMaxParts];
+    float* frame[kMaxParts];
+};
+
+__global__ void rig_kernel_launch(expression::RigView r, expression::RigFrame f, float* pos) {
+    const int v = blockIdx.x * blockDim.x + threadIdx.x;
+    if (v >= r.vertex_count) return;
+    const expression::rig_kernel::P3 p = expression::rig_kernel::position(r, f, v);
+    pos[3 * v] = p.x;
+    pos[3 * v + 1] = p.y;
+    pos[3 * v + 2] = p.z;
+}
+
+__global__ void part_kernel_launch(geometry_kernel::GeometryView g, const float* pos, PartOutputs out) {
+    const int pv = blockIdx.x * blockDim.x + threadIdx.x;
+    if (pv >= g.part_vertices) return;
+    const int part = g.part_of[pv];
+    const int local = pv - g.part_first[part];
+    float* frame = g.part_frames[part] && out.frame[part] ? out.frame[part] + 6 * local : nullptr;
+    geometry_kernel::part_vertex(g, pos, pv, out.shape[part] + 6 * local, frame);
+}
+
+// A host array copied to the device, freed with the owner.
+struct DeviceArrays {
+    std::vector<void*> blocks;
+    template <class T>
+    const T* copy(const T* host, std::size_t count) {
+        if (!host || count == 0) return nullptr;
+        void* d = nullptr;
+        check(cudaMalloc(&d, count * sizeof(T)), "cudaMalloc");
+        blocks.push_back(d);
+        check(cudaMemcpy(d, host, count * sizeof(T), cudaMemcpyHostToDevice), "cudaMemcpy");
+        return static_cast<const T*>(d);
+    }
+    ~DeviceArrays() {
+        for (void* b : blocks) cudaFree(b);
+    }
+};
+
+}  // namespace
+
+bool cuda_geometry_available() {
+    int count = 0;
+    if (cudaGetDeviceCount(&count) != cudaSuccess) {
+        cudaGetLastError();
+        return false;
+    }
+    return count > 0;
+}
+
+struct CudaGeometry::Impl {
+    DeviceArrays arrays;
+    expression::RigView rig;
+    geometry_kernel::GeometryView geometry;
+    int parts = 0;
+    std::vector<unsigned char> part_frames;
+    float* positions = nullptr;
+    cudaStream_t stream = nullptr;
+    ~Impl() {
+        if (positions) cudaFree(positions);
+        if (stream) cudaStreamDestroy(stream);
+    }
+};
+
+CudaGeometry::CudaGeometry(const FaceGeometry& fg) : impl_(std::make_unique<Impl>()) {
+    if (!cuda_geometry_available()) fail<EnvironmentError>("render: CUDA geometry: no CUDA device");
+    if (fg.part_count() > kMaxParts)
+        fail<InputError>("render: CUDA geometry: expected at most {} parts, found {}", kMaxParts, fg.part_count());
+    Impl& m = *impl_;
+    DeviceArrays& a = m.arrays;
+    const expression::RigView h = fg.rig().view();
+    const auto n = std::size_t(h.vertex_count);
+    m.rig = h;
+    m.rig.neutral = a.copy(h.neutral, 3 * n);
+    m.rig.influence_start = a.copy(h.influence_start, n + 1);
+    m.rig.influences = a.copy(h.influences, std::size_t(h.influence_start[n]));
+    m.rig.lid_start = a.copy(h.lid_start, n + 1);
+    m.rig.lid_weights = a.copy(h.lid_weights, std::size_t(h.lid_start[n]));
+    m.rig.slide_start = a.copy(h.slide_start, n + 1);
+    m.rig.slides = a.copy(h.slides, std::size_t(h.slide_start[n]));
+    m.rig.lash_anchor = a.copy(h.lash_anchor, n);
+    m.rig.lash_eye = a.copy(h.lash_eye, n);
+    m.rig.jaw_weight = a.copy(h.jaw_weight, n);
+    m.rig.eye_of = a.copy(h.eye_of, n);
+    m.rig.eye_polar = a.copy(h.eye_polar, n);
+    m.rig.eye_azimuth = a.copy(h.eye_azimuth, n);
+    m.rig.head_weight = a.copy(h.head_weight, n);
+
+    const geometry_kernel::GeometryView g = fg.view();
+    const auto full = std::size_t(g.full_vertices), pv = std::size_t(g.part_vertices);
+    const auto tris = std::size_t(g.vertex_face_start[full]);  // 3 x faces
+    m.parts = fg.part_count();
+    m.geometry = g;
+    m.geometry.triangles = a.copy(g.triangles, tris);
+    m.geometry.vertex_face_start = a.copy(g.vertex_face_start, full + 1);
+    m.geometry.vertex_faces = a.copy(g.vertex_faces, tris);
+    m.geometry.part_full = a.copy(g.part_full, pv);
+    m.geometry.part_of = a.copy(g.part_of, pv);
+    m.geometry.part_first = a.copy(g.part_first, std::size_t(m.parts) + 1);
+    m.geometry.part_triangles = a.copy(g.part_triangles, std::size_t(g.corner_start[pv]));
+    m.geometry.corner_start = a.copy(g.corner_start, pv + 1);
+    m.geometry.corners = a.copy(g.corners, std::size_t(g.corner_start[pv]));
+    m.geometry.part_frames = a.copy(g.part_frames, std::size_t(m.parts));
+    m.geometry.fixed_uvs = a.copy(g.fixed_uvs, g.fixed_uvs ? 2 * pv : 0);
+    m.part_frames.assign(g.part_frames, g.part_frames + m.parts);
+    check(cudaMalloc(reinterpret_cast<void**>(&m.positions), 3 * n * sizeof(float)), "cudaMalloc positions");
+    check(cudaStreamCreateWithFlags(&m.stream, cudaStreamNonBlocking), "cudaStreamCreate");
+}
+
+void* CudaGeometry::stream() const { return impl_->stream; }
+
+void CudaGeometry::finish() { check(cudaStreamSynchronize(impl_->stream), "cudaStreamSynchronize"); }
+
+CudaGeometry::~CudaGeometry() = default;
+
+void CudaGeometry::run(const expression::RigFrame& frame, const std::vector<float*>& shape,
+                       const std::vector<float*>& frame_out) {
+    Impl& m = *impl_;
+    if (int(shape.size()) != m.parts || int(frame_out.size()) != m.parts)
+        fail("render: CudaGeometry::run(): expected {} shape and frame pointers, found {} and {}", m.parts,
+             shape.size(), frame_out.size());
+    PartOutputs out{};
+    for (int p = 0; p < m.parts; ++p) {
+        if (!shape[std::size_t(p)]) fail("render: CudaGeometry::run(): part {} has no shape buffer", p);
+        if (m.part_frames[std::size_t(p)] && !frame_out[std::size_t(p)])
+            fail("render: CudaGeometry::run(): part {} has frames but no frame buffer", p);
+        out.shape[p] = shape[std::size_t(p)];
+        out.frame[p] = frame_out[std::size_t(p)];
+    }
+    const cudaStream_t s = m.stream;
+    constexpr int kBlock = 128;
+    const int n = m.rig.vertex_count, pv = m.geometry.part_vertices;
+    rig_kernel_launch<<<(n + kBlock - 1) / kBlock, kBlock, 0, s>>>(m.rig, frame, m.positions);
+    part_kernel_launch<<<(pv + kBlock - 1) / kBlock, kBlock, 0, s>>>(m.geometry, m.positions, out);
+    check(cudaGetLastError(), "launching the geometry kernels");
+}
+
+}  // namespace emoface::render
