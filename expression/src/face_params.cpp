@@ -317,6 +317,19 @@ FaceParams read_face_params(const std::string& params_dir) {
             a.lip_lines = r.number_in("lip_lines", 0.0, 1.0);
             a.lid_margin = colour(r, "lid_margin");
             {
+                JsonReader h = r.object("hairline");
+                a.fine_hairs.spacing = to_glm(h.numbers<2>("spacing_mm"));
+                a.fine_hairs.length = to_glm(h.numbers<2>("length_mm"));
+                if (!(a.fine_hairs.spacing[0] > 0.05 && a.fine_hairs.spacing[1] > 0.05))
+                    h.at("spacing_mm").fail("two spacings > 0.05 (mm)");
+                if (!(a.fine_hairs.length[0] > 0.1 && a.fine_hairs.length[1] >= a.fine_hairs.length[0] &&
+                      a.fine_hairs.length[1] < 30.0))
+                    h.at("length_mm").fail("shortest > 0.1 and <= longest < 30 (mm)");
+                a.fine_hairs.width = h.number_in("width_mm", 0.02, 1.0);
+                tint(h.object("roots"), &a.fine_hairs.roots_tint, &a.fine_hairs.roots_amount);
+                h.finish();
+            }
+            {
                 JsonReader g = r.object("roughness");
                 p.gloss.t_zone = g.number_in("t_zone", 0.3, 1.0);
                 p.gloss.lips = g.number_in("lips", 0.3, 1.0);

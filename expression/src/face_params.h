@@ -204,6 +204,13 @@ struct FaceParams {
         double beard_amount = 0.0, forehead_amount = 0.0, periorbital_amount = 0.0;
         double lip_border_mm = 0.0, lip_lines = 0.0;
         glm::dvec3 lid_margin{0.0};
+        // Single fine hairs at the hairline (face_texture.cpp).
+        struct FineHairs {
+            glm::dvec2 spacing{1.0}, length{1.0};  // mm: across, along the flow; shortest, longest
+            double width = 0.1;                     // mm at the root
+            glm::dvec3 roots_tint{1.0};
+            double roots_amount = 0.0;
+        } fine_hairs;
     } albedo;
     // roughness scale per region (the base map's alpha; 1 = skin.json's)
     struct Gloss {

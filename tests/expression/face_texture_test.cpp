@@ -151,7 +151,7 @@ TEST(FaceTexture, InnerBrowHairsStandUpAndOuterOnesLieAlong) {
 // luminance falls over several millimetres, and its height changes little
 // from one column to the next (no saw-tooth).
 TEST(FaceTexture, HairlineIsASoftSmoothBand) {
-    constexpr double kFrom = 62.0, kTo = 92.0;  // mm; face.json hairline_y 76
+    constexpr double kFrom = 50.0, kTo = 80.0;  // mm; face.json hairline_y 64
     constexpr int kSteps = 300;                 // 0.1 mm a step
     std::vector<double> crossing;
     for (double x = -16.0; x <= 16.0; x += 2.0) {
