@@ -72,6 +72,8 @@ WrinkleSpec read_wrinkle(JsonReader item) {
     w.depth = read_number(item, "depth", w.depth, 0.0f, 1.0f);
     w.width = read_number(item, "width", w.width, 1e-3f, 1.0f);
     w.taper = read_number(item, "taper", w.taper, 0.0f, 0.5f);
+    w.taper_end = read_number(item, "taper_end", w.taper, 0.0f, 0.9f);
+    w.crease = item.has("crease") ? read_number(item, "crease", 0.0f, 0.0f, 1.0f) : -1.0f;
     w.count = item.has("count") ? item.integer_in("count", 1, 12) : 1;
     if (item.has("step")) w.step = read_vec2(item.at("step"));
     w.depth_falloff = read_number(item, "depth_falloff", 1.0f, 0.0f, 2.0f);
@@ -88,7 +90,7 @@ struct Stroke {
     std::vector<glm::vec2> polyline;
     std::vector<float> arc;  // cumulative arc length at each polyline vertex
     std::vector<float> keep;  // depth factor at each vertex (1; less near the hairline)
-    float depth, sigma, taper, side;
+    float depth, sigma, taper, taper_end, crease, side;
     float swell_phase;  // where along the swell noise this stroke starts
     bool fine;          // a fine secondary line: a plain valley, no shoulders
     float split = 0.0f;  // +1 / -1: only the face's left / right half of it (an `across` wrinkle on one side)
@@ -201,7 +203,7 @@ std::vector<glm::vec2> displace(const std::vector<glm::vec2>& line, OffsetFn&& o
 }
 
 Stroke make_stroke(WrinkleProfile profile, std::vector<glm::vec2> polyline, float depth, float sigma, float taper,
-                   float side, float swell_phase, bool fine, float reach) {
+                   float taper_end, float crease, float side, float swell_phase, bool fine, float reach) {
     Stroke s;
     s.profile = profile;
     s.polyline = std::move(polyline);
@@ -210,6 +212,8 @@ Stroke make_stroke(WrinkleProfile profile, std::vector<glm::vec2> polyline, floa
     s.depth = depth;
     s.sigma = sigma;
     s.taper = taper;
+    s.taper_end = taper_end;
+    s.crease = crease;
     s.side = side;
     s.swell_phase = swell_phase;
     s.fine = fine;
@@ -235,6 +239,8 @@ void resolve_strokes(const std::vector<WrinkleSpec>& specs, const FoldShape& sha
         const std::vector<glm::vec2> curve = catmull_rom(base);
         const std::uint32_t seed = name_seed(spec.name);
         const float sigma = spec.width * unit;
+        const float taper_end = spec.taper_end < 0.0f ? spec.taper : spec.taper_end;
+        const float crease = spec.crease < 0.0f ? shape.core : spec.crease;
         // A valley with its shoulders on the wide flank reaches this far.
         const float wide = 1.0f + shape.asymmetry;
         const float reach = std::max(spec.profile == WrinkleProfile::Fold
@@ -242,8 +248,8 @@ void resolve_strokes(const std::vector<WrinkleSpec>& specs, const FoldShape& sha
                                          : (shape.shoulder_offset + 3.0f * shape.shoulder_width) * wide * sigma,
                                      3.0f * shape.wall_width * wide * sigma);
         if (curve.size() == 1) {  // a round mark: no along-the-fold shape
-            strokes.push_back(make_stroke(spec.profile, curve, scale * spec.depth * unit, sigma, 0.0f, spec.side,
-                                          0.0f, false, 3.0f * sigma));
+            strokes.push_back(make_stroke(spec.profile, curve, scale * spec.depth * unit, sigma, 0.0f, 0.0f, crease,
+                                          spec.side, 0.0f, false, 3.0f * sigma));
             continue;
         }
         const bool varied = spec.count > 1;
@@ -275,10 +281,11 @@ void resolve_strokes(const std::vector<WrinkleSpec>& specs, const FoldShape& sha
                 fine = displace(fine, [&](float) { return side * shape.fine_offset * sigma; });
                 strokes.push_back(make_stroke(WrinkleProfile::Groove, std::move(fine),
                                               shape.fine_depth * copy_depth * unit, shape.fine_width * sigma, 0.4f,
-                                              spec.side, phase + 13.0f, true, 3.0f * shape.fine_width * sigma));
+                                              0.4f, 0.0f, spec.side, phase + 13.0f, true,
+                                              3.0f * shape.fine_width * sigma));
             }
             strokes.push_back(make_stroke(spec.profile, std::move(line), copy_depth * unit, sigma, spec.taper,
-                                          spec.side, phase, false, reach));
+                                          taper_end, crease, spec.side, phase, false, reach));
         }
     }
     for (std::size_t i = first; i < strokes.size(); ++i) strokes[i].split = split;
@@ -322,10 +329,9 @@ float stroke_height(const Stroke& s, const FoldShape& shape, float unit, glm::ve
     // Along the fold: depth fades in smoothly at both ends, the width narrows
     // with it (no blunt ends), and the depth swells and thins gently.
     float window = 1.0f;
-    if (s.taper > 0.0f) {
-        const float u = arc_at / std::max(s.arc.back(), 1e-12f);
-        window = smoothstep01(u / s.taper) * smoothstep01((1.0f - u) / s.taper);
-    }
+    const float u = arc_at / std::max(s.arc.back(), 1e-12f);
+    if (s.taper > 0.0f) window *= smoothstep01(u / s.taper);
+    if (s.taper_end > 0.0f) window *= smoothstep01((1.0f - u) / s.taper_end);
     if (window <= 0.0f) return 0.0f;
     const float swell = 1.0f + shape.swell * noise1(arc_at / (shape.meander_wavelength * unit) + s.swell_phase, 3);
     const float depth = s.depth * window * swell * keep;
@@ -336,8 +342,8 @@ float stroke_height(const Stroke& s, const FoldShape& shape, float unit, glm::ve
     const float flank = sigma * (steep ? 1.0f - shape.asymmetry : 1.0f + shape.asymmetry);
     // The valley: a sharp narrow core (dark in its cavity) in broad shallow
     // walls, so the wall that faces the light catches little of it.
-    const float valley = shape.core * bump(best, shape.core_width * flank) +
-                         (1.0f - shape.core) * bump(best, shape.wall_width * flank);
+    const float valley = s.crease * bump(best, shape.core_width * flank) +
+                         (1.0f - s.crease) * bump(best, shape.wall_width * flank);
     switch (s.profile) {
         case WrinkleProfile::Groove:
         case WrinkleProfile::Dimple:

@@ -139,11 +139,12 @@ std::vector<Rect> region_rects(Region region, const FeatureLayout& l) {
             return {box({at("4.4").x, top - 0.75f * u}, {at("4.3").x, top - 0.18f * u})};
         }
         case Region::Glabella: {
-            // Between the brows, up to ~9 mm above them (0.14 pupil distances);
-            // above that is the forehead, whose lowest folds' broad crests
-            // reach down to about there.
+            // Between the brows, up to ~6 mm above them (0.09 pupil distances);
+            // above that is the forehead, whose lowest fold lies ~13 mm
+            // (0.21) above the inner brows, as on real faces, its broad soft
+            // lower wall reaching down to about 0.1.
             const glm::vec2 mid = 0.5f * (at("4.1") + at("4.2"));
-            return {box(mid + u * glm::vec2(-0.12f, -0.14f), mid + u * glm::vec2(0.12f, 0.08f))};
+            return {box(mid + u * glm::vec2(-0.12f, -0.09f), mid + u * glm::vec2(0.12f, 0.08f))};
         }
         case Region::EyeCorners:
             return {box(at("3.7") + u * glm::vec2(0.06f, -0.18f), at("3.7") + u * glm::vec2(0.3f, 0.18f)),
@@ -666,8 +667,8 @@ INSTANTIATE_TEST_SUITE_P(
                 "action_units.AU6.middle: expected a known key (left, right, across, why), found \"middle\""},
         BadSpec{"typo_in_wrinkle",
                 R"({"action_units": {"AU6": {"left": [{"name": "a", "dpeth": 0.1, "points": [{"fp": "4.1"}]}]}}})",
-                "action_units.AU6.left[0].dpeth: expected a known key (name, profile, points, depth, width, taper, "
-                "count, step, depth_falloff, side, why), found \"dpeth\""},
+                "action_units.AU6.left[0].dpeth: expected a known key (name, profile, points, depth, width, taper, taper_end, "
+                "crease, count, step, depth_falloff, side, why), found \"dpeth\""},
         BadSpec{"typo_at_top", R"({"action_units": {}, "neutral_skin_detial": {}})",
                 "neutral_skin_detial: expected a known key (action_units, fold_shape, cavity, neutral_skin_detail, "
                 "about), found \"neutral_skin_detial\""},

@@ -46,7 +46,10 @@ struct WrinkleSpec {
     std::vector<AnchoredPoint> points;  // a curve through them; one point = a round mark
     float depth = 0.02f;   // face units (height of the valley or ridge)
     float width = 0.03f;   // face units (Gaussian sigma across the curve)
-    float taper = 0.25f;   // fraction of the arc at each end over which depth fades in
+    float taper = 0.25f;   // fraction of the arc at the start over which depth fades in ...
+    float taper_end = -1.0f;  // ... and at the end (< 0: as taper); a long end taper fades a line outwards
+    float crease = -1.0f;  // share of the depth in the valley's narrow crease (< 0: FoldShape::core);
+                           // low for broad folds of bunched skin, higher for fine lines
     int count = 1;         // parallel copies ...
     glm::vec2 step{0.0f};  // ... each moved by this many face units from the last
     float depth_falloff = 1.0f;  // depth multiplier from one copy to the next
