@@ -2,13 +2,16 @@
 // frame sequence, or shown in the viewer when there is no --out.
 //   emoface play data/fap/demo_tour.fap --out out/demo.mp4 --size 640x480
 //   emoface play anim.fap --out frames/%04d.png --frames 0:50
+//   emoface play speech.fap --out talk.mp4 --audio speech.wav
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -28,9 +31,11 @@ using namespace emoface;
 using namespace emoface::apps;
 
 struct PlayArgs {
-    std::string fap, out, size = "1280x720", frames;
-    double fps = 0;
-    bool fps_given = false, frames_given = false;  // given, if only as 
+    std::string fap, out, size = "1280x720", frames, audio;
+    double fps = 0, audio_offset = 0;
+    int crf = -1;
+    bool fps_given = false, frames_given = false;  // given, if only as ''
+    bool audio_given = false, audio_offset_given = false, crf_given = false;
     SessionArgs session;
     ViewerOptions viewer;  // without --out
 };
@@ -73,15 +78,14 @@ OutKind output_kind(const std::string& out) {
     const auto dot = out.find_last_of('.');
     std::string ext = dot == std::string::npos ? "" : out.substr(dot);
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    if (ext == ".mp4" || ext == ".avi") {
+    if (render::VideoWriter::has_video_extension(out)) {
         if (out.find('%') != std::string::npos)
             fail<InputError>("play: --out {}: a video name has no %d (that is for frame sequences)", out);
         return OutKind::Video;
     }
     if (out.find('%') != std::string::npos) return OutKind::Sequence;
-    fail<InputError>("play: --out {}: expected a video (.mp4, .avi) or a frame pattern such as "
-                     "frames/%04d.png",
-                     out);
+    fail<InputError>("play: --out {}: expected a video ({}) or a frame pattern such as frames/%04d.png", out,
+                     render::VideoWriter::extensions());
 }
 
 // Frame i of the output at output rate `fps` (the stream's own rate: frame
@@ -99,6 +103,16 @@ fap::FapFrame frame_at(const fap::FapStream& resolved, double fps, int i) {
     return two.sample((position - double(k)) / resolved.fps);
 }
 
+// "--audio, --crf": the options only a video file takes, as given; "" for none.
+std::string video_only_options(const PlayArgs& a) {
+    std::string given;
+    for (const auto& [is_given, name] : {std::pair{a.audio_given, "--audio"},
+                                         std::pair{a.audio_offset_given, "--audio-offset"},
+                                         std::pair{a.crf_given, "--crf"}})
+        if (is_given) given += (given.empty() ? "" : ", ") + std::string(name);
+    return given;
+}
+
 // The viewer on the file, with every session option given.
 void run_viewer_for(const PlayArgs& a) {
     // The viewer plays the whole file at its own rate, scrubbed and paced by
@@ -109,6 +123,9 @@ void run_viewer_for(const PlayArgs& a) {
                          "its own rate (its timeline scrubs and sets the pace)",
                          a.fps_given && a.frames_given ? "--fps and --frames" : a.fps_given ? "--fps" : "--frames",
                          a.fps_given && a.frames_given ? "" : "s");
+    if (const std::string video_only = video_only_options(a); !video_only.empty())
+        fail<InputError>("play: {} belong{} to a video written with --out; the viewer plays no sound", video_only,
+                         video_only.find(' ') == std::string::npos ? "s" : "");
     ViewerOptions v = a.viewer;
     v.command = "play";
     v.fap_path = a.fap;
@@ -124,6 +141,13 @@ void run_play(const PlayArgs& a) {
     const fap::FapStream stream = load_fap_stream(a.fap);
     if (a.fps_given)
         check_in_range("play", "--fps", a.fps, render::kMinVideoFps, render::kMaxVideoFps, " frames per second");
+    if (a.crf_given) check_in_range("play", "--crf", a.crf, 0, 63, " (H.264 0..51, VP9 0..63)");
+    if (a.audio_given && a.audio.empty())
+        fail<InputError>("play: --audio '': expected a sound file (WAV, MP3, OGG... anything FFmpeg decodes)");
+    if (a.audio_offset_given) {
+        if (!a.audio_given) fail<InputError>("play: --audio-offset shifts the sound of --audio, which is not given");
+        check_in_range("play", "--audio-offset", a.audio_offset, -86400.0, 86400.0, " seconds");
+    }
     if (a.out.empty()) {
         run_viewer_for(a);
         return;
@@ -145,10 +169,21 @@ void run_play(const PlayArgs& a) {
 
     std::unique_ptr<render::FrameSequenceWriter> sequence;
     std::string folder;
+    render::VideoOptions video_options;
+    video_options.fps = fps;
+    video_options.crf = a.crf_given ? a.crf : -1;
+    video_options.audio = a.audio;
+    video_options.audio_offset = a.audio_offset;
+    // A slice's sound is the stretch under its frames: slices join exactly.
+    video_options.first_frame = first;
     if (kind == OutKind::Video) {
-        render::VideoWriter::check(a.out, so.picture_width(), height, fps);
+        // Opens the sound file and decodes its first frame.
+        render::VideoWriter::check(a.out, so.picture_width(), height, video_options);
         folder = split_output_path(a.out, "play", "--out").first;
     } else {
+        if (const std::string video_only = video_only_options(a); !video_only.empty())
+            fail<InputError>("{}: {} need{} a video ({}), not a frame pattern", what, video_only,
+                             video_only.find(' ') == std::string::npos ? "s" : "", render::VideoWriter::extensions());
         sequence = std::make_unique<render::FrameSequenceWriter>(a.out, first);
         render::check_image_output(sequence->path_for(first), what);
         folder = std::filesystem::path(sequence->path_for(first)).parent_path().string();
@@ -168,17 +203,16 @@ void run_play(const PlayArgs& a) {
     Session session(so);
 
     std::unique_ptr<render::VideoWriter> video;
-    if (kind == OutKind::Video) {
-        video = std::make_unique<render::VideoWriter>(batch.stage(file_name(a.out)), so.picture_width(), height, fps);
-        // No H.264 here: the writer chose name.avi.
-        if (file_name(video->path()) != file_name(a.out)) batch.stage(file_name(video->path()));
-    }
+    if (kind == OutKind::Video)
+        video = std::make_unique<render::VideoWriter>(batch.stage(file_name(a.out)), so.picture_width(), height,
+                                                      video_options);
 
     ProgressBar progress("play", end - first);
     for (int i = first; i < end; ++i) {
         const expression::FaceState state = session.face_state(frame_at(resolved, fps, i));
-        const render::ImageRGBA8 image = session.render_frame(state);
-        if (video) video->write(image);
+        render::ImageRGBA8 image = session.render_frame(state);
+        // Encoded on the writer's thread while the next frame renders.
+        if (video) video->write(std::move(image));
         else render::write_image(batch.stage(file_name(sequence->path_for(i))), image);
         progress.update(i - first + 1);
     }
@@ -189,11 +223,17 @@ void run_play(const PlayArgs& a) {
     const std::string slice =
         (first == 0 && end == count) ? "" : fmt::format(" (frames {}..{} of {})", first, end - 1, count);
     if (video) {
-        const std::string codec = video->codec();
-        const std::string path = batch.destination(file_name(video->path()));
-        fmt::print("play: wrote {}: {} frames{} {}x{} at {:g} frames/s, {}{}{}\n", path, end - first, slice,
-                   so.picture_width(), height, fps, codec == "H.264" ? "H.264 MP4" : "Motion-JPEG AVI",
-                   so.wrinkles_note(), codec != "H.264" && path != a.out ? " (OpenCV has no H.264 encoder here)" : "");
+        std::string container = std::filesystem::path(a.out).extension().string().substr(1);
+        std::transform(container.begin(), container.end(), container.begin(),
+                       [](unsigned char c) { return char(std::toupper(c)); });
+        const std::string quality = video->crf() >= 0 ? fmt::format(" (crf {})", video->crf()) : "";
+        const std::string sound =
+            a.audio.empty() ? ""
+                            : fmt::format(", {} sound from {}{}", video->audio_codec(), a.audio,
+                                          a.audio_offset != 0 ? fmt::format(" at {:+g} s", a.audio_offset) : "");
+        fmt::print("play: wrote {}: {} frames{} {}x{} at {:g} frames/s, {} {}{}{}{}\n",
+                   batch.destination(file_name(a.out)), end - first, slice, so.picture_width(), height, fps,
+                   video->codec(), container, quality, sound, so.wrinkles_note());
     } else {
         fmt::print("play: wrote {} .. {}: {} frames{} {}x{}{}\n", sequence->path_for(first),
                    sequence->path_for(end - 1), end - first, slice, so.picture_width(), height, so.wrinkles_note());
@@ -210,21 +250,32 @@ void add_play_command(CLI::App& root) {
     auto a = std::make_shared<PlayArgs>();
     sub->add_option("file", a->fap, "MPEG-4 FAP file (.fap)")->required();
     CLI::Option* out = sub->add_option("-o,--out", a->out,
-                    "Video (.mp4: H.264 where OpenCV can, else Motion-JPEG .avi; .avi) or frame "
-                    "pattern (frames/%04d.png, numbered by frame). Without it: the viewer");
+                    "Video (.mp4 or .mkv: H.264 + AAC; .webm: VP9 + Opus; .avi: Motion-JPEG + PCM) or "
+                    "frame pattern (frames/%04d.png, numbered by frame). Without it: the viewer");
     sub->add_option("--size", a->size, "Frame size WIDTHxHEIGHT")->capture_default_str();
     CLI::Option* fps = sub->add_option(
         "--fps", a->fps, "Output frame rate, 0.1..1000 (default: the file's); the animation is resampled");
     CLI::Option* frames = sub->add_option("--frames", a->frames,
                     "Render the slice A:B of the output frames, B exclusive (0:50 then 50:107 "
                     "together make 0:107); frame patterns are numbered by frame");
+    CLI::Option* audio = sub->add_option("--audio", a->audio,
+                    "Sound for the video (WAV, MP3, OGG, FLAC... anything FFmpeg decodes), starting with "
+                    "frame 0; cut or padded with silence to the video's length");
+    CLI::Option* audio_offset = sub->add_option("--audio-offset", a->audio_offset,
+                    "Seconds the sound starts after the animation (negative: its start is cut)");
+    CLI::Option* crf = sub->add_option("--crf", a->crf,
+                    "Video quality, lower is better and larger: H.264 0..51 (default 20), VP9 0..63 "
+                    "(default 31)");
     add_session_options(*sub, a->session);
     add_side_by_side_option(*sub, a->session);
     add_clamp_option(*sub, a->session);
     add_viewer_options(*sub, a->viewer, out);
-    sub->callback([a, fps, frames] {
+    sub->callback([a, fps, frames, audio, audio_offset, crf] {
         a->fps_given = fps->count() > 0;
         a->frames_given = frames->count() > 0;
+        a->audio_given = audio->count() > 0;
+        a->audio_offset_given = audio_offset->count() > 0;
+        a->crf_given = crf->count() > 0;
         run_play(*a);
     });
 }

@@ -90,7 +90,7 @@ TEST_F(BadOutput, PathsFailBeforeAnyLoadingAndLeaveNothing) {
         {args_with({"play", kTour, "--out", "out/f%d%d.png"}, kSmall),
          "render: frame pattern 'out/f%d%d.png': needs exactly one %d (like face_%04d.png), found 2"},
         {args_with({"play", kTour, "--out", "out/v.mov"}, kSmall),
-         "play: --out out/v.mov: expected a video (.mp4, .avi) or a frame pattern such as frames/%04d.png"},
+         "play: --out out/v.mov: expected a video (.mp4, .mkv, .webm, .avi) or a frame pattern such as frames/%04d.png"},
         {args_with({"play", kTour, "--out", "/proc/emoface/v.mp4"}, kSmall),
          "play: --out /proc/emoface/v.mp4: cannot write there: No such file or directory"},
         {args_with({"play", kTour, "--out", "/proc/emoface/f%04d.png"}, kSmall),
