@@ -325,6 +325,55 @@ int main(int argc, char** argv) {
         }
         glDeleteQueries(1, &query);
 
+        // Pass 3 (GPU geometry): the kernels alone, into device memory of
+        // their own (no interop), the rig alone and rig + parts, CUDA events
+        // around each launch pair.
+        Series rig_alone_s, kernels_alone_s;
+#if EMOFACE_BENCH_CUDA
+        if (scene.geometry()) {
+            render::FaceGeometry rig_only(*assets->rig, face.mesh, {},
+                                          {face.texture_box.min.x, face.texture_box.min.y, face.texture_box.max.x,
+                                           face.texture_box.max.y});
+            render::CudaGeometry rig_gpu(rig_only), all_gpu(*scene.geometry());
+            std::vector<float*> shape_d, frame_d;
+            for (int p = 0; p < scene.geometry()->part_count(); ++p) {
+                float* sp = nullptr;
+                float* fp = nullptr;
+                const std::size_t bytes = std::size_t(scene.geometry()->part_size(p)) * 6 * sizeof(float);
+                cudaMalloc(&sp, bytes);
+                if (scene.geometry()->part(p).frames) cudaMalloc(&fp, bytes);
+                shape_d.push_back(sp);
+                frame_d.push_back(fp);
+            }
+            cudaEvent_t a0, a1;
+            cudaEventCreate(&a0);
+            cudaEventCreate(&a1);
+            auto timed = [&](render::CudaGeometry& g, const expression::RigFrame& f, const std::vector<float*>& sh,
+                             const std::vector<float*>& fr) {
+                const auto st = static_cast<cudaStream_t>(g.stream());
+                cudaEventRecord(a0, st);
+                g.run(f, sh, fr);
+                cudaEventRecord(a1, st);
+                cudaEventSynchronize(a1);
+                float e = 0;
+                cudaEventElapsedTime(&e, a0, a1);
+                return double(e);
+            };
+            for (long i = 0; i < warmup + frames; ++i) {
+                const expression::RigFrame f = assets->rig->frame(state_of(frame_at(i)).faps);
+                const double r_ms = timed(rig_gpu, f, {}, {});
+                const double k_ms = timed(all_gpu, f, shape_d, frame_d);
+                if (i < warmup) continue;
+                rig_alone_s.add(r_ms);
+                kernels_alone_s.add(k_ms);
+            }
+            cudaEventDestroy(a0);
+            cudaEventDestroy(a1);
+            for (float* p : shape_d) cudaFree(p);
+            for (float* p : frame_d) cudaFree(p);
+        }
+#endif
+
         std::printf("\nthesis stage table (medians over %d frames; ms)\n", frames);
         std::printf("  %-44s %10s %10s\n", "stage", "median", "p90");
         auto row = [](const char* name, double median, double p90) {
@@ -339,6 +388,8 @@ int main(int argc, char** argv) {
         row("host: update (parameters, layout, launches)", host_update.median(), host_update.pct(0.9));
         row("host: sample .. draw submitted", host_submit.median(), host_submit.pct(0.9));
         row("GPU: rig + normals + UVs + tangents", geometry_gpu_s.median(), geometry_gpu_s.pct(0.9));
+        row("  of which kernels alone (no interop)", kernels_alone_s.median(), kernels_alone_s.pct(0.9));
+        row("  of which the rig kernel alone", rig_alone_s.median(), rig_alone_s.pct(0.9));
         row("GPU: morph (map + kernel + unmap)", morph_s.median(), morph_s.pct(0.9));
         row("GPU: compute (geometry + morph, medians)", geometry_gpu_s.median() + morph_s.median(),
             geometry_gpu_s.pct(0.9) + morph_s.pct(0.9));

@@ -99,6 +99,15 @@ void FaceGeometry::compute(const expression::RigFrame& frame, std::vector<std::v
             pos[3 * v] = p.x, pos[3 * v + 1] = p.y, pos[3 * v + 2] = p.z;
         }
     });
+    const int faces = int(triangles_.size() / 3), part_triangles = int(part_triangles_.size() / 3);
+    face_normals_.resize(std::size_t(faces));
+    triangle_frames_.resize(std::size_t(part_triangles));
+    parallel_for(faces, 4096, [&](int begin, int end) {
+        for (int f = begin; f < end; ++f) face_normals_[std::size_t(f)] = geometry_kernel::face_pass(g, pos, f);
+    });
+    parallel_for(part_triangles, 4096, [&](int begin, int end) {
+        for (int t = begin; t < end; ++t) triangle_frames_[std::size_t(t)] = geometry_kernel::part_triangle_pass(g, pos, t);
+    });
     shape.resize(parts_.size());
     frame_out.resize(parts_.size());
     for (std::size_t p = 0; p < parts_.size(); ++p) {
@@ -111,7 +120,8 @@ void FaceGeometry::compute(const expression::RigFrame& frame, std::vector<std::v
         const int first = part_first_[p];
         parallel_for(size, 4096, [&](int begin, int end) {
             for (int i = begin; i < end; ++i)
-                geometry_kernel::part_vertex(g, pos, first + i, s + 6 * i, f ? f + 6 * i : nullptr);
+                geometry_kernel::part_vertex_pass(g, pos, face_normals_.data(), triangle_frames_.data(), first + i,
+                                                  s + 6 * i, f ? f + 6 * i : nullptr);
         });
     }
 }

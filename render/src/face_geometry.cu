@@ -1,7 +1,8 @@
-// CudaGeometry: FaceGeometry's kernel bodies on the GPU. Two launches per
-// frame on its own stream: the rig over the full mesh into a device
-// scratch of positions, then one thread per part vertex for its normal,
-// wrinkle UV and tangent frame, written where the caller says (the mapped GL
+// CudaGeometry: FaceGeometry's kernel bodies on the GPU. Three launches per
+// frame on its own stream: the rig over the full mesh into a device scratch
+// of positions, one thread per face (normal) and per part triangle (frame),
+// then one thread per part vertex for its normal, wrinkle UV and tangent
+// frame, gathered from those, written where the caller says (the mapped GL
 // vertex buffers). The frame's parameters travel as the first launch's
 // argument: no copy, no wait.
 #include <cuda_runtime.h>
@@ -27,21 +28,40 @@ struct PartOutputs {
 };
 
 __global__ void rig_kernel_launch(expression::RigView r, expression::RigFrame f, float* pos) {
+    // The frame's tables are read at each vertex's own feature points: from
+    // the launch's constant bank such scattered reads go one address at a
+    // time per warp, from shared memory in parallel. So each block copies
+    // the frame there first.
+    __shared__ expression::RigFrame frame;
+    static_assert(sizeof(expression::RigFrame) % sizeof(int) == 0, "copied as words");
+    const int* src = reinterpret_cast<const int*>(&f);
+    int* dst = reinterpret_cast<int*>(&frame);
+    for (int i = threadIdx.x; i < int(sizeof(expression::RigFrame) / sizeof(int)); i += blockDim.x) dst[i] = src[i];
+    __syncthreads();
     const int v = blockIdx.x * blockDim.x + threadIdx.x;
     if (v >= r.vertex_count) return;
-    const expression::rig_kernel::P3 p = expression::rig_kernel::position(r, f, v);
+    const expression::rig_kernel::P3 p = expression::rig_kernel::position(r, frame, v);
     pos[3 * v] = p.x;
     pos[3 * v + 1] = p.y;
     pos[3 * v + 2] = p.z;
 }
 
-__global__ void part_kernel_launch(geometry_kernel::GeometryView g, const float* pos, PartOutputs out) {
+__global__ void face_kernel_launch(geometry_kernel::GeometryView g, const float* pos, int faces, int part_triangles,
+                                   geometry_kernel::V3* face_normals, geometry_kernel::FaceFrame* triangle_frames) {
+    const int i = blockIdx.x * blockDim.x + threadIdx.x;
+    if (i < faces) face_normals[i] = geometry_kernel::face_pass(g, pos, i);
+    else if (i < faces + part_triangles) triangle_frames[i - faces] = geometry_kernel::part_triangle_pass(g, pos, i - faces);
+}
+
+__global__ void part_kernel_launch(geometry_kernel::GeometryView g, const float* pos,
+                                   const geometry_kernel::V3* face_normals,
+                                   const geometry_kernel::FaceFrame* triangle_frames, PartOutputs out) {
     const int pv = blockIdx.x * blockDim.x + threadIdx.x;
     if (pv >= g.part_vertices) return;
     const int part = g.part_of[pv];
     const int local = pv - g.part_first[part];
     float* frame = g.part_frames[part] && out.frame[part] ? out.frame[part] + 6 * local : nullptr;
-    geometry_kernel::part_vertex(g, pos, pv, out.shape[part] + 6 * local, frame);
+    geometry_kernel::part_vertex_pass(g, pos, face_normals, triangle_frames, pv, out.shape[part] + 6 * local, frame);
 }
 
 // A host array copied to the device, freed with the owner.
@@ -79,9 +99,14 @@ struct CudaGeometry::Impl {
     int parts = 0;
     std::vector<unsigned char> part_frames;
     float* positions = nullptr;
+    geometry_kernel::V3* face_normals = nullptr;
+    geometry_kernel::FaceFrame* triangle_frames = nullptr;
+    int faces = 0, part_triangles = 0;
     cudaStream_t stream = nullptr;
     ~Impl() {
         if (positions) cudaFree(positions);
+        if (face_normals) cudaFree(face_normals);
+        if (triangle_frames) cudaFree(triangle_frames);
         if (stream) cudaStreamDestroy(stream);
     }
 };
@@ -128,6 +153,13 @@ CudaGeometry::CudaGeometry(const FaceGeometry& fg) : impl_(std::make_unique<Impl
     m.geometry.fixed_uvs = a.copy(g.fixed_uvs, g.fixed_uvs ? 2 * pv : 0);
     m.part_frames.assign(g.part_frames, g.part_frames + m.parts);
     check(cudaMalloc(reinterpret_cast<void**>(&m.positions), 3 * n * sizeof(float)), "cudaMalloc positions");
+    m.faces = int(tris / 3);
+    m.part_triangles = g.corner_start[pv] / 3;
+    check(cudaMalloc(reinterpret_cast<void**>(&m.face_normals), std::size_t(m.faces + 1) * sizeof(geometry_kernel::V3)),
+          "cudaMalloc face normals");
+    check(cudaMalloc(reinterpret_cast<void**>(&m.triangle_frames),
+                     std::size_t(m.part_triangles + 1) * sizeof(geometry_kernel::FaceFrame)),
+          "cudaMalloc triangle frames");
     check(cudaStreamCreateWithFlags(&m.stream, cudaStreamNonBlocking), "cudaStreamCreate");
 }
 
@@ -152,10 +184,17 @@ void CudaGeometry::run(const expression::RigFrame& frame, const std::vector<floa
         out.frame[p] = frame_out[std::size_t(p)];
     }
     const cudaStream_t s = m.stream;
-    constexpr int kBlock = 128;
+    constexpr int kBlock = 256;
     const int n = m.rig.vertex_count, pv = m.geometry.part_vertices;
     rig_kernel_launch<<<(n + kBlock - 1) / kBlock, kBlock, 0, s>>>(m.rig, frame, m.positions);
-    part_kernel_launch<<<(pv + kBlock - 1) / kBlock, kBlock, 0, s>>>(m.geometry, m.positions, out);
+    if (pv > 0) {
+        const int items = m.faces + m.part_triangles;
+        face_kernel_launch<<<(items + kBlock - 1) / kBlock, kBlock, 0, s>>>(m.geometry, m.positions, m.faces,
+                                                                           m.part_triangles, m.face_normals,
+                                                                           m.triangle_frames);
+        part_kernel_launch<<<(pv + kBlock - 1) / kBlock, kBlock, 0, s>>>(m.geometry, m.positions, m.face_normals,
+                                                                        m.triangle_frames, out);
+    }
     check(cudaGetLastError(), "launching the geometry kernels");
 }
 

@@ -1,10 +1,11 @@
 #pragma once
-// A frame's drawn geometry from its FAPs, in one pass of kernel bodies: the
-// rig (expression/rig_kernel.h) gives every vertex's position; then each
-// vertex of each drawn part (skin, eyes, mouth: FaceScene's meshes) gets its
-// vertex normal (the full mesh's faces around it, as OpenMesh's), and in the
-// parts with wrinkles its wrinkle UV and tangent frame
-// (render/geometry_kernel.h), written in the renderer's vertex layout:
+// A frame's drawn geometry from its FAPs, in three passes of kernel bodies:
+// the rig (expression/rig_kernel.h) gives every vertex's position; each face
+// its normal and each part triangle its frame; then each vertex of each
+// drawn part (skin, eyes, mouth: FaceScene's meshes) gets its vertex normal
+// (the full mesh's faces around it, as OpenMesh's), and in the parts with
+// wrinkles its wrinkle UV and tangent frame (render/geometry_kernel.h),
+// written in the renderer's vertex layout:
 //   shape: 6 floats per vertex (position, normal)
 //   frame: 6 floats per vertex (tangent xyzw, wrinkle UV)
 // FaceGeometry holds the topology and runs the bodies on the CPU (all
@@ -60,7 +61,10 @@ private:
     std::vector<unsigned char> part_frames_;
     std::vector<float> fixed_uvs_;
     std::array<float, 4> box_;
-    std::vector<float> positions_;  // scratch: 3 per full vertex
+    // Scratch: 3 floats per full vertex, a normal per face, a frame per part triangle.
+    std::vector<float> positions_;
+    std::vector<geometry_kernel::V3> face_normals_;
+    std::vector<geometry_kernel::FaceFrame> triangle_frames_;
 };
 
 // Whether this build and machine can run CudaGeometry.

@@ -163,6 +163,8 @@ public:
     bool uses_gpu_geometry() const { return cuda_geometry_ != nullptr; }
     // The CUDA stream the GPU geometry runs on (null without it).
     void* geometry_stream() const;
+    // The geometry the GPU runs (null without it).
+    const FaceGeometry* geometry() const { return geometry_.get(); }
     int key_count() const;
     const expression::TriMesh& mesh() const { return mesh_; }
     const expression::FeatureLayout& layout() const { return layout_; }
