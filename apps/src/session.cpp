@@ -44,14 +44,16 @@ void add_times(render::FrameStageTimes& a, const render::FrameStageTimes& b, dou
     a.upload_ms += scale * b.upload_ms;
 }
 
-// CPU time of the whole process (every thread), in milliseconds.
+}  // namespace
+
+// --- small shared helpers ---------------------------------------------------
+
 double process_cpu_ms() {
     timespec t{};
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
     return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
 }
 
-// The 1-minute load average, for reading a wall-clock figure ("" where unknown).
 std::string load_average() {
     std::ifstream in("/proc/loadavg");
     std::string one;
@@ -59,9 +61,6 @@ std::string load_average() {
     return one;
 }
 
-}  // namespace
-
-// --- small shared helpers ---------------------------------------------------
 
 void FrameTimeTotals::add(const FrameTimes& t) {
     add_times(sum.scene, t.scene);
@@ -122,9 +121,17 @@ morph::Backend parse_backend(const std::string& text, const std::string& command
     fail<InputError>("{}: --backend '{}': expected auto, cpu or cuda", command, text);
 }
 
+morph::Accuracy morph_accuracy_for(const std::string& command) {
+    return command == "play" || command == "view" ? morph::Accuracy::Fast : morph::Accuracy::Exact;
+}
+
 SessionOptions SessionArgs::resolve(const std::string& command, int width, int height) const {
     SessionOptions o = options;
     o.backend = parse_backend(backend, command);
+    if (morph_accuracy.empty()) o.morph_accuracy = morph_accuracy_for(command);
+    else if (morph_accuracy == "exact") o.morph_accuracy = morph::Accuracy::Exact;
+    else if (morph_accuracy == "fast") o.morph_accuracy = morph::Accuracy::Fast;
+    else fail<InputError>("{}: --morph-accuracy '{}': expected exact or fast", command, morph_accuracy);
     const auto kind = render::parse_wrinkle_layout(layout);
     if (!kind) fail<InputError>("{}: --layout '{}': expected projective or anchored", command, layout);
     o.layout = *kind;
@@ -149,6 +156,9 @@ void add_session_options(CLI::App& sub, SessionArgs& a) {
         ->capture_default_str();
     sub.add_option("--fdp", o.fdp, "Feature points of an .obj face (default: FILE.fdp.json beside it)");
     sub.add_option("--backend", a.backend, "Morph backend: auto, cpu or cuda")->capture_default_str();
+    sub.add_option("--morph-accuracy", a.morph_accuracy,
+                   "Wrinkle morph: exact, or fast (lines summed on a grid and interpolated away from them); "
+                   "default: fast for play and view, exact for pictures");
     sub.add_option("--wrinkle-size", o.wrinkle_size, "Side of the wrinkle maps (256..4096)")->capture_default_str();
     sub.add_option("--samples", o.samples, "Multisampling samples")->check(CLI::Range(1, 16))->capture_default_str();
     sub.add_flag("--no-wrinkles", a.no_wrinkles, "Draw without the wrinkle maps");
@@ -292,6 +302,7 @@ void Session::make_scene() {
     scene_.reset();
     render::FaceSceneOptions so;
     so.backend = options_.backend;
+    so.morph.accuracy = options_.morph_accuracy;
     scene_ = render::make_face_scene(*platform_, *assets_, so);
     // The scene starts neutral.
     const auto fp = assets_->rig->feature_points(expression::FapValues{});
@@ -406,10 +417,11 @@ std::array<std::optional<glm::vec2>, expression::kFeatureCount> Session::screen_
 
 std::string Session::description() const {
     const auto& f = assets_->face;
-    return fmt::format("{} face ({} vertices, {} triangles), {} feature lines, wrinkle maps {}x{}, morph on {}{}",
+    return fmt::format("{} face ({} vertices, {} triangles), {} feature lines, wrinkle maps {}x{}, morph on {}{}{}",
                        f.name.empty() ? options_.face : f.name, f.vertex_count(), f.mesh.n_faces(),
                        assets_->lines.size(), options_.wrinkle_size, options_.wrinkle_size,
                        morph::to_string(scene_->morpher().backend()),
+                       options_.morph_accuracy == morph::Accuracy::Fast ? " (fast)" : "",
                        scene_->uses_interop() ? " (CUDA-GL interop)" : "");
 }
 

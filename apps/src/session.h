@@ -47,6 +47,10 @@ struct SessionOptions {
     std::string fdp;
     std::string data = EMOFACE_DATA_DIR;  // the project's data/ folder
     morph::Backend backend = morph::Backend::Auto;
+    // Exact, or the morph's grid-interpolated fast mode (morph.h): the
+    // commands that play in time (play, view) take fast by default, the
+    // pictures (mix, inspect, morph) exact.
+    morph::Accuracy morph_accuracy = morph::Accuracy::Exact;
     int wrinkle_size = 512;  // side of the key and morphed wrinkle maps, 256..4096
     bool wrinkles = true;    // false: draw with geometric normals only
     // Skin (data/render/skin.json's model and light rig) or the thesis's
@@ -88,6 +92,9 @@ struct SessionOptions {
 struct SessionArgs {
     SessionOptions options;
     std::string backend = "auto";
+    // --morph-accuracy exact | fast; empty: the command's default
+    // (morph_accuracy_for()).
+    std::string morph_accuracy;
     std::string layout = "projective";
     std::string shading = "skin";
     bool no_wrinkles = false;
@@ -137,6 +144,12 @@ struct FrameTimeTotals {
     FrameTimes mean() const;
 };
 
+// The CPU time of the whole process so far (user + sys, every thread), ms.
+double process_cpu_ms();
+// The 1-minute load average ("" where unknown): a wall-clock figure on a
+// shared machine is read with it.
+std::string load_average();
+
 // Lines of "stage   mean ms" for a report: loading, then per frame.
 std::string format_times(const LoadTimes& load, const FrameTimeTotals& frames);
 
@@ -145,6 +158,12 @@ std::string format_times(const LoadTimes& load, const FrameTimeTotals& frames);
 // capture CSV, expression/capture.h; `data` holds the AU and ARKit tables);
 // InputError when it has no frames or its frame rate is not positive.
 fap::FapStream load_fap_stream(const std::string& path, const std::string& data = EMOFACE_DATA_DIR);
+
+// The morph accuracy a command takes when --morph-accuracy is not given:
+// fast for the commands that play frames in time (play, view; their
+// frames differ from exact ones by far less than a golden's tolerance, see
+// tests/apps/realtime_test.cpp), exact for the pictures.
+morph::Accuracy morph_accuracy_for(const std::string& command);
 
 // "auto" | "cpu" | "cuda"; InputError otherwise.
 morph::Backend parse_backend(const std::string& text, const std::string& command);

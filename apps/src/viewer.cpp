@@ -187,7 +187,16 @@ public:
     void run() {
         auto last = Clock::now();
         int frames = 0;
+        // From the fourth frame on (the first ones compile shaders and show
+        // the loading panel): wall clock and CPU time, for the closing line.
+        constexpr int kSettled = 3;
+        Clock::time_point settled_at;
+        double settled_cpu_ms = 0;
         while (!window_.should_close()) {
+            if (frames == kSettled) {
+                settled_at = Clock::now();
+                settled_cpu_ms = process_cpu_ms();
+            }
             // Idle (nothing plays, changes or is dragged): sleep until an
             // event comes, or a few times a second, instead of spinning.
             const bool busy = (playing_ && stream_) || dirty_ || frames < 3 || ImGui::IsAnyMouseDown() ||
@@ -210,6 +219,15 @@ public:
             if (frames == 2) glfwSetWindowTitle(window_.window(), title().c_str());
             ++frames;
             if (options_.quit_after_frames > 0 && frames >= options_.quit_after_frames) break;
+        }
+        if (frames > kSettled) {
+            const int n = frames - kSettled;
+            const double wall_ms = seconds_since(settled_at) * 1000.0;
+            const std::string load = load_average();
+            std::printf("%s: %d frames after the first %d: %.1f ms a frame (%.1f frames/s), CPU %.1f ms a frame "
+                        "(user + sys, all threads)%s\n",
+                        options_.command.c_str(), n, kSettled, wall_ms / n, wall_ms > 0 ? 1000.0 * n / wall_ms : 0.0,
+                        (process_cpu_ms() - settled_cpu_ms) / n, load.empty() ? "" : ("; load average " + load).c_str());
         }
     }
 
