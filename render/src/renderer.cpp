@@ -44,6 +44,9 @@ Camera Camera::frontal(const glm::vec3& box_min, const glm::vec3& box_max, float
 
 namespace {
 
+// Triangles sorted together for the draw order (add_mesh).
+constexpr std::size_t kDrawCluster = 64;
+
 // Per-vertex data that changes every frame, in two buffers: the shape, and
 // the wrinkle map's frame (not needed when the shader derives it).
 struct ShapeVertex {
@@ -184,6 +187,7 @@ struct Renderer::Impl {
         GLuint detail_texture = 0;
         float detail_levels = 0.0f;
         GLuint vao = 0, shape_vbo = 0, frame_vbo = 0, static_vbo = 0, ebo = 0;
+        GLuint occlusion_vbo = 0;  // attribute 5; none: the constant 1 (open)
         GLsizei index_count = 0;
         std::size_t vertex_count = 0;
         std::vector<glm::vec2> base_uvs;
@@ -200,7 +204,8 @@ struct Renderer::Impl {
             light_diffuse, light_specular, specular_color, shininess, camera_position, projective,
             box, skin_model, skin_surface, scatter_table, max_curvature, mm_per_unit,
             normal_softening, cavity_direct, pore_map, pore_tiles, pore_strength, detail_map, albedo_bump, f0, roughness,
-            lobe_weight, fill_direction, fill_colour, rim_direction, rim_colour, sky, ground,
+            lobe_weight, gloss_exponent, sheen_intensity, occlusion, min_curvature, wrap, key_tint,
+            fill_direction, fill_colour, rim_direction, rim_colour, sky, ground,
             exposure, tone_map;
     } loc{};
     std::vector<Mesh> meshes;
@@ -221,10 +226,10 @@ struct Renderer::Impl {
         if (m.base_texture) glDeleteTextures(1, &m.base_texture);
         if (m.detail_texture) glDeleteTextures(1, &m.detail_texture);
         m.detail_texture = 0;
-        const GLuint buffers[4] = {m.shape_vbo, m.frame_vbo, m.static_vbo, m.ebo};
-        glDeleteBuffers(4, buffers);
+        const GLuint buffers[5] = {m.shape_vbo, m.frame_vbo, m.static_vbo, m.ebo, m.occlusion_vbo};
+        glDeleteBuffers(5, buffers);
         if (m.vao) glDeleteVertexArrays(1, &m.vao);
-        m.base_texture = m.vao = m.shape_vbo = m.frame_vbo = m.static_vbo = m.ebo = 0;
+        m.base_texture = m.vao = m.shape_vbo = m.frame_vbo = m.static_vbo = m.ebo = m.occlusion_vbo = 0;
     }
 
     // Binds the scattering table to unit 2 and the pore map to unit 3,
@@ -293,6 +298,12 @@ Renderer::Renderer(Platform& platform) : impl_(std::make_unique<Impl>(platform))
     l.f0 = u("u_f0");
     l.roughness = u("u_roughness");
     l.lobe_weight = u("u_lobe_weight");
+    l.gloss_exponent = u("u_gloss_exponent");
+    l.sheen_intensity = u("u_sheen_intensity");
+    l.occlusion = u("u_occlusion");
+    l.min_curvature = u("u_min_curvature");
+    l.wrap = u("u_wrap");
+    l.key_tint = u("u_key_tint");
     l.fill_direction = u("u_fill_direction");
     l.fill_colour = u("u_fill_colour");
     l.rim_direction = u("u_rim_direction");
@@ -343,6 +354,33 @@ Renderer::MeshId Renderer::add_mesh(const expression::TriMesh& mesh, const Mater
             fail("render: Renderer::add_mesh(): face {} has {} vertices, expected a triangle",
                  fh.idx(), k);
         indices.insert(indices.end(), tri, tri + 3);
+    }
+    // Nearest the frontal camera (+z) first, so the depth test rejects the
+    // back of the head, the neck behind the chin and the like before they
+    // are shaded. Runs of kDrawCluster triangles in the mesh's order are
+    // sorted by their mean depth, not single triangles: neighbours stay
+    // together and share their transformed vertices.
+    {
+        const std::size_t triangles = indices.size() / 3;
+        const std::size_t clusters = (triangles + kDrawCluster - 1) / kDrawCluster;
+        std::vector<float> depth(clusters, 0.0f);
+        std::vector<std::uint32_t> order(clusters);
+        for (std::size_t t = 0; t < triangles; ++t)
+            for (int c = 0; c < 3; ++c)
+                depth[t / kDrawCluster] += mesh.point(mesh.vertex_handle(int(indices[3 * t + std::size_t(c)])))[2];
+        for (std::size_t k = 0; k < clusters; ++k) {
+            order[k] = std::uint32_t(k);
+            depth[k] /= float(std::min(kDrawCluster, triangles - k * kDrawCluster));
+        }
+        std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return depth[a] > depth[b]; });
+        std::vector<std::uint32_t> sorted;
+        sorted.reserve(indices.size());
+        for (const std::uint32_t k : order) {
+            const std::size_t begin = 3 * std::size_t(k) * kDrawCluster;
+            const std::size_t end = std::min(indices.size(), begin + 3 * kDrawCluster);
+            sorted.insert(sorted.end(), indices.begin() + std::ptrdiff_t(begin), indices.begin() + std::ptrdiff_t(end));
+        }
+        indices.swap(sorted);
     }
     m.index_count = GLsizei(indices.size());
     m.base_uvs.assign(m.vertex_count, glm::vec2(0.0f));
@@ -409,6 +447,23 @@ void Renderer::set_material(MeshId id, const Material& material) {
     m.base_texture = texture;
     m.detail_texture = 0;
     m.material = material;
+}
+
+void Renderer::set_occlusion(MeshId id, const std::vector<float>& occlusion) {
+    impl_->platform.make_current();
+    Impl::Mesh& m = impl_->mesh(id);
+    if (occlusion.size() != m.vertex_count)
+        fail("render: Renderer::set_occlusion(): {} values for mesh {} of {} vertices, expected one each",
+             occlusion.size(), id, m.vertex_count);
+    if (!m.occlusion_vbo) glGenBuffers(1, &m.occlusion_vbo);
+    glBindVertexArray(m.vao);
+    glBindBuffer(GL_ARRAY_BUFFER, m.occlusion_vbo);
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(occlusion.size() * sizeof(float)), occlusion.data(), GL_STATIC_DRAW);
+    glEnableVertexAttribArray(5);
+    glVertexAttribPointer(5, 1, GL_FLOAT, GL_FALSE, sizeof(float), nullptr);
+    glBindVertexArray(0);
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
+    check_gl("Renderer::set_occlusion(): uploading the occlusion");
 }
 
 void Renderer::update_mesh(MeshId id, const expression::TriMesh& mesh,
@@ -548,6 +603,12 @@ void Renderer::draw(const DrawOptions& o, const WrinkleTexture* wrinkle_map) {
         glUniform1f(im.loc.f0, k.f0);
         glUniform2f(im.loc.roughness, k.roughness[0], k.roughness[1]);
         glUniform1f(im.loc.lobe_weight, k.lobe_weight);
+        glUniform1f(im.loc.gloss_exponent, k.gloss_exponent);
+        glUniform2f(im.loc.sheen_intensity, k.matte_sheen, k.full_sheen_gloss);
+        glUniform3f(im.loc.occlusion, k.occlusion_key, k.occlusion_fill, k.occlusion_specular);
+        glUniform1f(im.loc.min_curvature, k.min_curvature / k.max_curvature);
+        glUniform1f(im.loc.wrap, k.softness);
+        glUniform3fv(im.loc.key_tint, 1, glm::value_ptr(k.key_tint));
         glUniform3fv(im.loc.fill_direction, 1, glm::value_ptr(k.fill.direction));
         glUniform3fv(im.loc.fill_colour, 1, glm::value_ptr(k.fill.colour));
         glUniform3fv(im.loc.rim_direction, 1, glm::value_ptr(k.rim.direction));
@@ -572,6 +633,7 @@ void Renderer::draw(const DrawOptions& o, const WrinkleTexture* wrinkle_map) {
         }
         glActiveTexture(GL_TEXTURE0);
         glBindTexture(GL_TEXTURE_2D, m.base_texture);
+        if (!m.occlusion_vbo) glVertexAttrib1f(5, 1.0f);
         glBindVertexArray(m.vao);
         glDrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
     }

@@ -12,6 +12,7 @@ layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec4 a_tangent;      // xyz tangent, w handedness
 layout(location = 3) in vec2 a_wrinkle_uv;   // per-frame UVs of the wrinkle map
 layout(location = 4) in vec2 a_base_uv;      // the mesh's own UVs
+layout(location = 5) in float a_occlusion;   // baked ambient occlusion, 1 = open
 
 uniform mat4 u_model;
 uniform mat3 u_normal_matrix;
@@ -28,6 +29,7 @@ out vec3 v_normal;
 out vec4 v_tangent;
 out vec2 v_wrinkle_uv;
 out vec2 v_base_uv;
+out float v_occlusion;
 
 void main() {
     vec4 world = u_model * vec4(a_position, 1.0);
@@ -48,6 +50,7 @@ void main() {
     v_tangent = vec4(mat3(u_model) * tangent.xyz, tangent.w);
     v_wrinkle_uv = wrinkle_uv;
     v_base_uv = a_base_uv;
+    v_occlusion = a_occlusion;
     gl_Position = u_view_projection * world;
 }
 )GLSL";
@@ -70,6 +73,7 @@ in vec3 v_normal;
 in vec4 v_tangent;
 in vec2 v_wrinkle_uv;
 in vec2 v_base_uv;
+in float v_occlusion;
 
 uniform sampler2D u_base_map;     // sRGB texture: sampled as linear
 uniform bool u_has_base_map;
@@ -102,6 +106,12 @@ uniform float u_albedo_bump;        // detail height (scene units) per unit of t
 uniform float u_f0;
 uniform vec2 u_roughness;
 uniform float u_lobe_weight;
+uniform float u_gloss_exponent;     // roughness x gloss^this (gloss: the base map's alpha)
+uniform vec2 u_sheen_intensity;     // direct sheen at gloss 1 (matte), gloss at which it is full
+uniform vec3 u_occlusion;           // how far the baked occlusion dims: key, fill/rim/sky diffuse, specular
+uniform float u_min_curvature;      // table coordinate: the flattest skin still scatters
+uniform float u_wrap;               // the rig lights' softness (wrapped N.L, energy kept)
+uniform vec3 u_key_tint;
 uniform vec3 u_fill_direction;
 uniform vec3 u_fill_colour;
 uniform vec3 u_rim_direction;
@@ -177,6 +187,10 @@ struct Surface {
     float alpha_mean;  // one lobe standing for both (fill and rim)
     float lobe_weight;
     float cavity;    // 1 open skin, 0 a deep crevice
+    float direct_sheen;   // the region's scale of the lights' sheen
+    float key_shadow;     // the occlusion's dimming of the key's diffuse light
+    float dim_shadow;     // ... of the fill's, the rim's and the sky's
+    float dim_sheen;      // specular occlusion of the fill, the rim and the sky
 };
 
 // One light's contribution (colour `c`, direction `l` towards it). `full`
@@ -185,17 +199,24 @@ struct Surface {
 // scattering table and the two GGX lobes. Otherwise the dim lights' (fill,
 // rim) reduced model: one lookup at the green channel's softened normal and
 // one lobe standing for both.
+// The rig's lights are soft boxes, not points: N.L is wrapped by w,
+// (N.L + w) / (1 + w), and the result divided by 1 + w so that the light
+// a surface gets over all directions stays the same (the terminator moves
+// past 90 degrees and softens; nothing is added).
 vec3 shade_light(Surface s, vec3 l, vec3 c, const bool full) {
     vec3 diffuse;
     if (u_skin_surface) {
+        float wrap_scale = 1.0 / (1.0 + u_wrap);
         if (full) {
-            vec3 u = clamp(0.5 + 0.5 * vec3(dot(s.n_r, l), dot(s.n_g, l), dot(s.n_b, l)), 0.0, 1.0);
+            vec3 n_dot_l = (vec3(dot(s.n_r, l), dot(s.n_g, l), dot(s.n_b, l)) + u_wrap) * wrap_scale;
+            vec3 u = clamp(0.5 + 0.5 * n_dot_l, 0.0, 1.0);
             diffuse = vec3(textureLod(u_scatter_table, vec2(u.r, s.curvature), 0.0).r,
                            textureLod(u_scatter_table, vec2(u.g, s.curvature), 0.0).g,
                            textureLod(u_scatter_table, vec2(u.b, s.curvature), 0.0).b);
+            diffuse *= wrap_scale * s.key_shadow;
         } else {
-            float u = clamp(0.5 + 0.5 * dot(s.n_g, l), 0.0, 1.0);
-            diffuse = textureLod(u_scatter_table, vec2(u, s.curvature), 0.0).rgb;
+            float u = clamp(0.5 + 0.5 * (dot(s.n_g, l) + u_wrap) * wrap_scale, 0.0, 1.0);
+            diffuse = textureLod(u_scatter_table, vec2(u, s.curvature), 0.0).rgb * (wrap_scale * s.dim_shadow);
         }
         diffuse *= s.direct_cavity;
     } else {
@@ -210,7 +231,8 @@ vec3 shade_light(Surface s, vec3 l, vec3 c, const bool full) {
         float lobes = full ? s.lobe_weight * ggx_dv(s.alpha.x, n_dot_h, n_dot_l, s.n_dot_v) +
                                  (1.0 - s.lobe_weight) * ggx_dv(s.alpha.y, n_dot_h, n_dot_l, s.n_dot_v)
                            : ggx_dv(s.alpha_mean, n_dot_h, n_dot_l, s.n_dot_v);
-        color += vec3(PI * lobes * fresnel(s.f0, dot(l, h)) * n_dot_l);
+        float sheen = PI * lobes * fresnel(s.f0, dot(l, h)) * n_dot_l * s.direct_sheen;
+        color += vec3(full ? sheen : sheen * s.dim_sheen);
     }
     return color * c;
 }
@@ -224,9 +246,17 @@ vec3 shade_skin(vec3 n_bumped, vec3 n_geo, vec3 base, float cavity, float gloss,
     Surface s;
     s.v = normalize(u_camera_position - v_position);
     s.cavity = cavity;
+    s.direct_sheen = 1.0;
     vec2 roughness;
+    float occlusion = 1.0;
     if (u_skin_surface) {
-        roughness = u_roughness * clamp(gloss, 0.3, 1.0);
+        // Regions: matte cheeks and lower face (gloss 1) reflect the lights
+        // dimly through a broad lobe; the oilier T-zone, the moist lips
+        // and the wet lid margins (gloss below 1) sharper and fuller.
+        float g = clamp(gloss, 0.3, 1.0);
+        roughness = u_roughness * pow(g, u_gloss_exponent);
+        s.direct_sheen = mix(1.0, u_sheen_intensity.x, smoothstep(u_sheen_intensity.y, 1.0, g));
+        occlusion = v_occlusion;
         s.lobe_weight = u_lobe_weight;
         // Pores, in the frame of the base UVs built from screen derivatives
         // (Schueler 2006); their filtered normal's shortening (Toksvig)
@@ -257,10 +287,12 @@ vec3 shade_skin(vec3 n_bumped, vec3 n_geo, vec3 base, float cavity, float gloss,
         float variance = u_pore_strength * u_pore_strength * (1.0 - shortening) / shortening;
         roughness = sqrt(clamp(roughness * roughness + vec2(variance), 0.0, 1.0));
         s.cavity = cavity * pore.a;
-        // Curvature of the geometric surface (Penner): |dN| / |dP| in 1/mm.
+        // Curvature of the geometric surface (Penner): |dN| / |dP| in 1/mm,
+        // at least the flattest skin's (light scatters a few mm in red even
+        // where the surface is flat at that scale: a red, soft terminator).
         float dn = length(fwidth(n_geo));
         float dp = length(fwidth(v_position)) * u_mm_per_unit;
-        s.curvature = clamp(dn / max(dp, 1e-6) / u_max_curvature, 0.0, 1.0);
+        s.curvature = clamp(dn / max(dp, 1e-6) / u_max_curvature, u_min_curvature, 1.0);
         // Each channel sees a normal softened towards the geometric one;
         // the same for every light, so made once here.
         s.n_r = normalize(mix(s.n, n_geo, u_normal_softening.r));
@@ -286,19 +318,27 @@ vec3 shade_skin(vec3 n_bumped, vec3 n_geo, vec3 base, float cavity, float gloss,
     float diffuse_share = 1.0 - sheen;
     s.diffuse_albedo = base * diffuse_share;
     s.direct_cavity = mix(1.0, s.cavity, u_cavity_direct);
+    // The baked occlusion (eye sockets, nostrils, mouth corners, under the
+    // jaw, the ears, the hairline) stands for the shadows the rig's broad
+    // lights would cast there: fully for the sky, mostly for the fill and
+    // the rim, a little for the key (its shadows are not drawn). With the
+    // wrinkle and pore cavity it also fades the sheen (Lagarde & de
+    // Rousiers 2014).
+    s.key_shadow = mix(1.0, occlusion, u_occlusion.x);
+    s.dim_shadow = mix(1.0, occlusion, u_occlusion.y);
+    float ambient_open = s.cavity * mix(1.0, occlusion, u_occlusion.z);
+    s.dim_sheen = specular_occlusion(s.n_dot_v, ambient_open, mean_roughness);
 
     vec3 key = u_light_position.w == 0.0 ? normalize(u_light_position.xyz)
                                          : normalize(u_light_position.xyz - v_position);
-    vec3 color = shade_light(s, key, u_light_diffuse, true);
+    vec3 color = shade_light(s, key, u_light_diffuse * u_key_tint, true);
     color += shade_light(s, normalize(u_fill_direction), u_fill_colour, false);
     color += shade_light(s, normalize(u_rim_direction), u_rim_colour, false);
 
     // The sky/ground hemisphere: diffuse from the softest normal, specular
-    // by the environment BRDF towards the reflection, both occluded in the
-    // cavity.
-    color += hemisphere(s.n_r) * s.diffuse_albedo * s.cavity;
-    color += hemisphere(reflect(-s.v, s.n)) * sheen *
-             specular_occlusion(s.n_dot_v, s.cavity, mean_roughness);
+    // by the environment BRDF towards the reflection, both occluded.
+    color += hemisphere(s.n_r) * s.diffuse_albedo * (s.cavity * s.dim_shadow);
+    color += hemisphere(reflect(-s.v, s.n)) * sheen * s.dim_sheen;
     return color;
 }
 

@@ -45,6 +45,7 @@ SkinShading load_skin_shading(const std::string& path) {
             g.finish();
         }
         s.max_curvature = float(scatter.number_in("max_curvature_per_mm", 1e-3, 10.0));
+        s.min_curvature = float(scatter.number_in("min_curvature_per_mm", 0.0, s.max_curvature));
         s.mm_per_unit = float(scatter.number_in("mm_per_unit", 1e-6, 1e6));
         s.normal_softening = vec3_at(scatter, "normal_softening");
         for (int c = 0; c < 3; ++c)
@@ -62,7 +63,16 @@ SkinShading load_skin_shading(const std::string& path) {
             s.roughness[std::size_t(i)] = float(rough[std::size_t(i)]);
         }
         s.lobe_weight = float(spec.number_in("lobe_weight", 0.0, 1.0));
+        s.gloss_exponent = float(spec.number_in("gloss_exponent", 0.0, 8.0));
+        s.matte_sheen = float(spec.number_in("matte_sheen", 0.0, 1.0));
+        s.full_sheen_gloss = float(spec.number_in("full_sheen_gloss", 0.0, 0.99));
         spec.finish();
+
+        JsonReader occlusion = root.object("occlusion");
+        s.occlusion_key = float(occlusion.number_in("key", 0.0, 1.0));
+        s.occlusion_fill = float(occlusion.number_in("fill", 0.0, 1.0));
+        s.occlusion_specular = float(occlusion.number_in("specular", 0.0, 1.0));
+        occlusion.finish();
 
         JsonReader pores = root.object("pores");
         s.pores.size = pores.integer_in("map_size", 8, 2048);
@@ -82,6 +92,8 @@ SkinShading load_skin_shading(const std::string& path) {
         detail.finish();
 
         JsonReader rig = root.object("light_rig");
+        s.key_tint = colour_at(rig, "key_tint");
+        s.softness = float(rig.number_in("softness", 0.0, 1.0));
         s.fill = rig_light(rig.object("fill"));
         s.rim = rig_light(rig.object("rim"));
         s.sky = colour_at(rig, "sky");

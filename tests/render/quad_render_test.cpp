@@ -599,6 +599,33 @@ TEST_F(SkinQuad, AlbedoReliefLeansTheNormalDownItsSlope) {
 }
 
 #ifdef EMOFACE_DATA_DIR
+// The baked ambient occlusion (Renderer::set_occlusion) under the sky
+// alone: an occluded surface gets less of the sky's diffuse light, and its
+// sheen (a black surface: nothing else comes back) fades with it, as the
+// wrinkle cavity's does.
+TEST_F(SkinQuad, OcclusionDimsTheSkyAndItsSheen) {
+    SkinShading skin = dark_rig();
+    skin.sky = skin.ground = glm::vec3(0.6f);
+    Light off;
+    off.diffuse = glm::vec3(0.0f);
+    Material m;
+    m.uses_wrinkle_map = true;  // a skin surface
+    const std::size_t n = make_quad(UvLayout::VUp).n_vertices();
+    auto lit = [&](const glm::vec3& albedo, float occlusion, float view_deg) {
+        renderer_->set_occlusion(white_, std::vector<float>(n, occlusion));
+        m.base_color = albedo;
+        return draw(m, view_deg, off, skin);
+    };
+    const glm::vec3 grey(0.5f), black(0.0f);
+    const glm::vec3 open = lit(grey, 1.0f, 0.0f), shut = lit(grey, 0.3f, 0.0f);
+    const float open_sheen = lit(black, 1.0f, 60.0f).g, shut_sheen = lit(black, 0.3f, 60.0f).g;
+    renderer_->set_occlusion(white_, std::vector<float>(n, 1.0f));  // the other tests' quad: open
+    EXPECT_LT(shut.g, 0.6f * open.g) << "occlusion dims the sky's diffuse light";
+    EXPECT_GT(shut.g, 0.0f);
+    EXPECT_GT(open_sheen, 0.0f);
+    EXPECT_LT(shut_sheen, 0.5f * open_sheen) << "and its sheen";
+}
+
 // SkinShading's defaults are data/render/skin.json's values.
 TEST(SkinShadingData, DefaultsAreTheDataFile) {
     const SkinShading loaded = load_skin_shading(std::string(EMOFACE_DATA_DIR) + "/render/skin.json");

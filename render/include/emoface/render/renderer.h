@@ -123,7 +123,9 @@ public:
     Renderer& operator=(const Renderer&) = delete;
 
     // Uploads a mesh's topology and base UVs and its current shape (with the
-    // base UVs as wrinkle UVs). Meshes are drawn in the order added.
+    // base UVs as wrinkle UVs). Meshes are drawn in the order added; a mesh's
+    // triangles nearest the +z side first (the frontal camera's view: what
+    // they hide is then rejected by the depth test before it is shaded).
     MeshId add_mesh(const expression::TriMesh& mesh, const Material& material);
 
     // The mesh's new shape (points, vertex normals) and wrinkle UVs (one per
@@ -145,6 +147,9 @@ public:
     // 6 floats per vertex (position, normal), frame 6 (tangent xyzw, wrinkle
     // UV); for a writer on the GPU (face_geometry.h) instead of update_mesh().
     std::array<unsigned, 2> vertex_buffers(MeshId id) const;
+    // Static ambient occlusion, one value per vertex in [0, 1] (1 = open;
+    // ambient_occlusion.h); skin shading only. Without it a mesh is open.
+    void set_occlusion(MeshId id, const std::vector<float>& occlusion);
     std::size_t mesh_count() const;
 
     // Draws every mesh. `wrinkle_map` null, or options.wrinkles false: flat

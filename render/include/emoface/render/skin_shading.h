@@ -90,6 +90,10 @@ struct SkinShading {
     }};
     // Curvature range of the lookup table (1/mm); flatter is Lambert.
     float max_curvature = 0.5f;
+    // The flattest skin is looked up as this curved (1/mm): red light
+    // scatters several mm, so even a broad forehead's terminator is soft
+    // and reddish rather than a plastic Lambert edge.
+    float min_curvature = 0.1f;
     // Millimetres per scene unit (the default face is modelled in mm).
     float mm_per_unit = 1.0f;
     // How far each channel's diffuse normal leans from the bumped normal to
@@ -101,8 +105,20 @@ struct SkinShading {
 
     // --- specular: two GGX lobes with Fresnel ---
     float f0 = 0.028f;
-    std::array<float, 2> roughness{0.45f, 0.70f};
+    std::array<float, 2> roughness{0.5f, 0.75f};
     float lobe_weight = 0.85f;  // of roughness[0]; the other lobe gets the rest
+    // Regions (the base map's alpha g, 1 on cheeks and the lower face):
+    // roughness x g^gloss_exponent, and the lights' sheen scaled from
+    // matte_sheen at g = 1 up to 1 at g <= full_sheen_gloss (the T-zone,
+    // lips, lid margins).
+    float gloss_exponent = 2.0f;
+    float matte_sheen = 0.55f;
+    float full_sheen_gloss = 0.8f;
+
+    // --- baked ambient occlusion (ambient_occlusion.h): how far it dims ---
+    float occlusion_key = 0.25f;       // the key's diffuse light (its shadows are not drawn)
+    float occlusion_fill = 0.8f;       // the fill's, the rim's and the sky's diffuse light
+    float occlusion_specular = 1.0f;   // the sky's, the fill's and the rim's sheen
 
     // --- pores ---
     PoreMapSpec pores{};
@@ -113,19 +129,26 @@ struct SkinShading {
     float albedo_bump_mm = 0.5f;   // height per unit of log-luminance contrast
     float albedo_bump_bias = 2.0f;  // the mean's extent, in mip levels (skin_maps.h)
 
-    // --- light rig (the key light is the draw's Light) ---
-    RigLight fill{{0.7f, 0.1f, 0.7f}, {0.16f, 0.17f, 0.19f}};
+    // --- light rig (the key light is the draw's Light, tinted) ---
+    glm::vec3 key_tint{1.06f, 0.98f, 0.88f};
+    float softness = 0.2f;  // wrap of every rig light's N.L (soft boxes), energy kept
+    RigLight fill{{0.7f, 0.1f, 0.7f}, {0.17f, 0.2f, 0.26f}};
     RigLight rim{{0.5f, 0.6f, -0.65f}, {0.36f, 0.34f, 0.31f}};
-    glm::vec3 sky{0.22f, 0.23f, 0.25f};     // ambient from above (+y)
-    glm::vec3 ground{0.10f, 0.08f, 0.07f};  // ambient from below (warm bounce)
+    glm::vec3 sky{0.25f, 0.27f, 0.31f};       // ambient from above (+y)
+    glm::vec3 ground{0.14f, 0.105f, 0.085f};  // ambient from below (warm bounce)
     float exposure = 1.0f;
     ToneMapping tone_mapping = ToneMapping::Aces;
 
     bool operator==(const SkinShading& o) const {
         return profile == o.profile && max_curvature == o.max_curvature &&
                mm_per_unit == o.mm_per_unit && normal_softening == o.normal_softening &&
+               min_curvature == o.min_curvature &&
                cavity_direct == o.cavity_direct && f0 == o.f0 && roughness == o.roughness &&
-               lobe_weight == o.lobe_weight && pores == o.pores && pore_tiles == o.pore_tiles &&
+               lobe_weight == o.lobe_weight && gloss_exponent == o.gloss_exponent &&
+               matte_sheen == o.matte_sheen && full_sheen_gloss == o.full_sheen_gloss &&
+               occlusion_key == o.occlusion_key && occlusion_fill == o.occlusion_fill &&
+               occlusion_specular == o.occlusion_specular && key_tint == o.key_tint &&
+               softness == o.softness && pores == o.pores && pore_tiles == o.pore_tiles &&
                pore_strength == o.pore_strength && albedo_bump_mm == o.albedo_bump_mm &&
                albedo_bump_bias == o.albedo_bump_bias && fill == o.fill && rim == o.rim &&
                sky == o.sky && ground == o.ground && exposure == o.exposure &&
