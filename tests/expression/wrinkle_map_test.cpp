@@ -256,6 +256,11 @@ struct Placement {
 };
 constexpr float kStrong = 0.02f;
 constexpr float kWeak = 0.008f;
+// |n.xy| of the steepest texel a key may have: 0.8 (the deep nasolabial
+// fold of AU12 is the steepest, ~0.76), and 0.6 for the glabella's keys
+// (AU4, anger), whose furrows read as engraved at 0.69-0.72 (issue 11).
+constexpr float kSteepestTilt = 0.8f;
+constexpr float kSteepestGlabellaTilt = 0.6f;
 
 class WrinklePlacement : public ::testing::TestWithParam<Placement> {};
 
@@ -531,6 +536,52 @@ INSTANTIATE_TEST_SUITE_P(Profiles, FoldShoulders,
                                            ShoulderCase{"fold_left", WrinkleProfile::Fold, 1.0f},
                                            ShoulderCase{"fold_right", WrinkleProfile::Fold, -1.0f}),
                          [](const auto& info) { return std::string(info.param.name); });
+
+// Skin, not engraving (issue 11): no wrinkle of any key is cut so steeply
+// that its wall turns far from the surface (a groove as deep as it is wide,
+// with most of its depth in a sharp core, tilts the normal by 0.85 and more).
+TEST_P(EveryKey, SlopesStaySkinLike) {
+    const NormalMap& map = key_map(GetParam());
+    float steepest = 0.0f;
+    for (int y = 0; y < map.height; ++y)
+        for (int x = 0; x < map.width; ++x) {
+            const glm::vec3 n = decode(map, x, y);
+            steepest = std::max(steepest, std::sqrt(n.x * n.x + n.y * n.y));
+        }
+    std::printf("%s: steepest tilt %.3f\n", GetParam().c_str(), steepest);
+    const bool glabella = GetParam().rfind("AU4", 0) == 0 || GetParam() == "anger";
+    EXPECT_LT(steepest, glabella ? kSteepestGlabellaTilt : kSteepestTilt)
+        << GetParam() << " has a wall as steep as an engraved line";
+}
+
+// A line with a long end taper (crow's feet) is deepest near its start and
+// fades out towards its end.
+TEST(FoldShape, TaperEndFadesTheLineOutwards) {
+    WrinkleLibrarySpec library = spec();
+    WrinkleSpec w;
+    w.name = "test line";
+    w.depth = 0.02f;
+    w.width = 0.02f;
+    w.taper = 0.1f;
+    w.taper_end = 0.8f;
+    w.points = {AnchoredPoint{fap::feature_point_index("3.12"), -1, 0.5f, {0.0f, -0.35f}},
+                AnchoredPoint{fap::feature_point_index("3.7"), -1, 0.5f, {0.0f, -0.35f}}};
+    library.action_units = {AuWrinkles{12, {}, {}, {w}}};
+    const FeatureLayout& layout = key_layout("joy");
+    constexpr int kSize = 512;
+    const std::vector<float> height = render_height_field(library, {{12, AuSide::Both, 1.0f}}, layout, kSize);
+    // The deepest point of the columns a fifth and four fifths along the line.
+    const glm::vec2 a = layout.at("3.12"), b = layout.at("3.7");
+    const auto deepest_at = [&](float t) {
+        const int col = static_cast<int>((a.x + t * (b.x - a.x)) * kSize);
+        float deepest = 0.0f;
+        for (int r = 0; r < kSize; ++r) deepest = std::min(deepest, height[r * kSize + col]);
+        return -deepest;
+    };
+    const float near_start = deepest_at(0.2f), near_end = deepest_at(0.8f);
+    ASSERT_GT(near_start, 0.0f);
+    EXPECT_LT(near_end, 0.6f * near_start);
+}
 
 // The hairline of a layout at column x: the polyline 11.2 - 11.1 - 11.3.
 float hairline_y(const FeatureLayout& l, float x) {
