@@ -8,6 +8,7 @@
 #include <glm/trigonometric.hpp>
 #include <glm/geometric.hpp>
 
+#include "emoface/common/parallel.h"
 #include "eye_texture.h"
 
 namespace emoface::expression::detail {
@@ -80,7 +81,9 @@ private:
     double brow_density(const BrowPlace& b) const;
     // Brow hairs' coverage at (x, y) and their colour.
     double brow_hairs(double x, double y, Rgb* colour) const;
-    double hair(glm::dvec3 q, Rgb* colour) const;
+    // Hair cover 0 (skin) .. 1 and its colour; *roots: how much the roots'
+    // grey shows under the skin (the scalp under thinning hair).
+    double hair(glm::dvec3 q, Rgb* colour, double* roots) const;
 
     const FaceShape& s_;
     const FaceParams& p_;
@@ -127,9 +130,11 @@ Painter::BrowPlace Painter::brow_place(double x, double y) const {
 double Painter::brow_density(const BrowPlace& b) const {
     const double q = b.distance / b.half;
     if (q > 1.4 || (b.t <= 0.0 && b.distance > 0.3 * b.half)) return 0.0;
-    double d = 1.0 - glm::smoothstep(0.5, 1.3, q);
-    d *= 0.5 + 0.5 * glm::smoothstep(0.0, 0.25, b.t);  // sparse at the inner end
-    d *= 1.0 - 0.6 * glm::smoothstep(0.8, 1.0, b.t);    // and thinning to the tail
+    // Feathered edges: fewer hairs towards the brow's upper and lower rims,
+    // so its outline is the hairs' own and not a drawn shape.
+    double d = 1.0 - glm::smoothstep(0.35, 1.3, q);
+    d *= 0.4 + 0.6 * glm::smoothstep(0.0, 0.3, b.t);   // sparse at the inner end
+    d *= 1.0 - 0.7 * glm::smoothstep(0.6, 1.0, b.t);   // and thinning to the tail
     return d;
 }
 
@@ -213,7 +218,8 @@ double Painter::brow_hairs(double x, double y, Rgb* colour) const {
         const double cover = (1.0 - glm::smoothstep(half, half + 0.22, across)) *
                              glm::smoothstep(-0.05, 0.05, along) * (1.0 - glm::smoothstep(0.92, 1.05, along));
         if (cover <= 0.0) continue;
-        clear *= 1.0 - 0.8 * cover;
+        // A single hair lets some skin through (it is thinner than a texel).
+        clear *= 1.0 - 0.7 * cover;
         // Lighter towards the tip, where the hair is thinner.
         const double shade = h.shade * (0.85 + 0.35 * std::clamp(along, 0.0, 1.0));
         sum = {sum.r + brow.r * shade * cover, sum.g + brow.g * shade * cover, sum.b + brow.b * shade * cover};
@@ -227,64 +233,122 @@ double Painter::brow_hairs(double x, double y, Rgb* colour) const {
 // Hair of the scalp: 0 (skin) .. 1, and its colour. The strands run from the
 // crown over the surface; strand coordinates are the azimuth round the crown
 // (across) and the distance from it (along).
-double Painter::hair(glm::dvec3 q, Rgb* colour) const {
+double Painter::hair(glm::dvec3 q, Rgb* colour, double* roots) const {
+    *roots = 0.0;
     const double ax = std::abs(q.x);
     // The hairline is the head's (FaceShape: the hair volume rises from the
     // same line), so paint and geometry agree.
     const double line = s_.hairline(q);
     // Height above the hairline, its course wandering gently (low-frequency
-    // only: a saw-tooth edge reads as a wig).
+    // only: a saw-tooth edge reads as a wig; the fine hairs below make it
+    // irregular at the small scale).
     double edge = q.y - line + (noise(q.x * 0.09, q.y * 0.09, q.z * 0.09 + 5.0) - 0.5) * 4.0;
     // Leave the ears bare.
     if (ax > 55 && s_.ear_relief(q.y, q.z) > 0.3) edge = std::min(edge, -4.0);
     const double band = p_.hairline_band;
-    if (edge < -0.4 * band) return 0.0;
+    const FaceParams::Albedo::FineHairs& fh = p_.albedo.fine_hairs;
+    if (edge < -0.4 * band - fh.length[1]) return 0.0;
+    // Where hair grows the roots show grey through the skin; they thin out
+    // with the hair below the line.
+    *roots = glm::smoothstep(-0.5 * band, 0.6 * band, edge);
 
-    // Strand coordinates round the crown.
-    const double along = glm::length(q - p_.hair_crown);
-    const glm::dvec3 axis = glm::normalize(p_.hair_crown - glm::dvec3{0.0, 0.0, 0.0});
-    glm::dvec3 e1 = glm::normalize(glm::cross(axis, glm::dvec3{1.0, 0.0, 0.0}));
-    glm::dvec3 e2 = glm::cross(axis, e1);
+    // Strand coordinates round the crown. The azimuth's wrap (+-pi) lies
+    // behind and below the crown, on the nape, where no view of the face
+    // sees the seam it makes in the strands.
     const glm::dvec3 rel = q - p_.hair_crown;
+    const double along = glm::length(rel);
+    const glm::dvec3 axis = glm::normalize(p_.hair_crown);
+    const glm::dvec3 e1 = -glm::normalize(glm::cross(axis, glm::dvec3{1.0, 0.0, 0.0}));
+    const glm::dvec3 e2 = glm::cross(axis, e1);
     const double azimuth = std::atan2(glm::dot(rel, e2), glm::dot(rel, e1));
     // Across in mm at a typical distance; fanning out with distance is the whorl.
     const double across = azimuth * 70.0;
     const double w = p_.hair_strand_width, len = p_.hair_strand_length;
-    // Clumps: each a band across, with its own phase along, so its tips
-    // (lighter, thinner) fall in different places.
-    const double clump_w = 4.0 * w;
-    const double cu = across / clump_w;
+    // Clumps: bands across whose course sways as they run (combed hair is
+    // not a set of parallel grooves), each with its own width, tone and
+    // phase along, so its tips (lighter, thinner) fall in different places.
+    const double sway = 5.0 * (noise(across * 0.04, along * 0.03, 12.0) - 0.5) + 1.2 * (noise(across * 0.15, along * 0.07, 13.0) - 0.5);
+    const double clump_w = 6.0 * w;
+    const double cu = (across + sway) / clump_w;
     const int ci = static_cast<int>(std::floor(cu));
     const double phase = hash(ci, 7, 3);
     const double tip = std::fmod(along / len + phase + 100.0, 1.0);
-    const double strands = 0.45 * noise(across / w, along / (0.35 * len), 1.0) +
-                           0.35 * noise(across / (0.5 * w), along / (0.25 * len), 2.0) +
-                           0.2 * noise(across / (2.3 * w), along / len, 3.0);
-    const double clump_edge = std::abs(cu - ci - 0.5) * 2.0;  // 0 mid-clump .. 1 between clumps
-    double value = 0.85 + 0.9 * (strands - 0.5) - 0.45 * clump_edge * clump_edge;
-    value *= 1.0 + p_.hair_tip_lightening * glm::smoothstep(0.4, 1.0, tip);
+    const double ac = across + sway;
+    const double strands = 0.45 * noise(ac / w, along / (0.35 * len), 1.0) +
+                           0.35 * noise(ac / (0.5 * w), along / (0.25 * len), 2.0) +
+                           0.2 * noise(ac / (2.3 * w), along / len, 3.0);
+    // 0 mid-clump .. 1 between clumps; clumps part unevenly.
+    const double split = 0.35 + 0.3 * hash(ci, 13, 5);
+    const double f = cu - ci;
+    const double clump_edge = f < split ? 1.0 - f / split : (f - split) / (1.0 - split);
+    const double part = 0.2 + 0.35 * hash(ci, 17, 5);  // how deep the gap to the next clump is
+    double value = 0.85 + 0.55 * (strands - 0.5) - part * clump_edge * clump_edge * clump_edge;
+    // A light sheen line along the middle of each clump, where its strands
+    // lie flattest.
+    value += 0.18 * (1.0 - glm::smoothstep(0.0, 0.45, clump_edge)) * noise(ac / (3.0 * w), along / (0.6 * len), 14.0);
+    // Lighter towards each clump's tips, smoothly both ways (a ramp that
+    // drops back at the next root draws a line across the clump).
+    const double tip_light = std::sin(kPi * tip);
+    value *= 1.0 + p_.hair_tip_lightening * tip_light * tip_light;
     // Clumps and tufts differ in tone, and broad patches (about 12 mm) are
     // lighter or darker: an even tone and one sheen over the crown read as a
     // cap; these break the albedo's relief, and with it the highlight, up.
-    value *= 0.82 + 0.36 * hash(ci, 11, 5);
+    value *= 0.8 + 0.4 * hash(ci, 11, 5);
+    value *= 0.75 + 0.5 * noise(cu * 0.4, along / 14.0, 15.0);  // tufts of a few clumps
     value *= 0.72 + 0.56 * noise(q.x * 0.08, q.y * 0.08, q.z * 0.08 + 9.0);
-    *colour = from255(p_.hair) * std::max(value, 0.15);
+    const Rgb hair_colour = from255(p_.hair);
+    *colour = hair_colour * std::max(value, 0.15);
 
-    // The hairline: hair thins over the band, the strands parting so that
-    // single fine ones reach into it.
-    const double density = glm::smoothstep(-0.4 * band, 0.6 * band, edge);
+    // The hairline: the mass of hair thins over the band, and single fine
+    // hairs grow from it over the skin, fewer the further out; each lies
+    // along the strands' flow, tip away from the crown.
+    const double density = glm::smoothstep(-0.2 * band, 0.7 * band, edge);
     if (density >= 1.0) return 1.0;
-    const double fine = noise(across / (0.6 * w), along / (0.5 * len), 4.0);
-    const double strand = glm::smoothstep(0.42, 0.62, fine);
-    // Baby hairs are finer and lighter.
-    *colour = blend(*colour, *colour * 1.15, 1.0 - density);
-    return std::clamp(density * mix(strand, 1.0, density), 0.0, 1.0);
+    // Hairs on a jittered grid in strand coordinates (mm across at the
+    // hairline's distance from the crown, mm along).
+    const double fa = azimuth * 120.0;
+    const double sa = fh.spacing[0], sl = fh.spacing[1];
+    const int ia = static_cast<int>(std::floor(fa / sa)), il = static_cast<int>(std::floor(along / sl));
+    const int back = static_cast<int>(std::ceil(fh.length[1] / sl));
+    double clear = 1.0;
+    Rgb sum{};
+    double weight = 0.0;
+    for (int dl = -back; dl <= 0; ++dl)
+        for (int da = -1; da <= 1; ++da) {
+            const int i = ia + da, j = il + dl;
+            const double root_a = (i + hash(i, j, 101)) * sa, root_l = (j + hash(i, j, 103)) * sl;
+            const double length = mix(fh.length[0], fh.length[1], hash(i, j, 107));
+            // Leaning a little off the flow, each its own way.
+            const double lean = 0.5 * (hash(i, j, 109) - 0.5);
+            const double t = (along - root_l) / length;
+            if (t < 0.0 || t > 1.0) continue;
+            const double off = std::abs(fa - root_a - lean * (along - root_l));
+            const double half = 0.5 * fh.width * (1.0 - 0.6 * t);
+            if (off > half + 0.2) continue;
+            // The root's place against the hairline: the surface climbs
+            // about a millimetre towards the crown per millimetre along.
+            const double root_edge = edge + (along - root_l);
+            // Patchy: tufts of fine hairs with gaps of bare skin between.
+            const double grows = glm::smoothstep(-0.55 * band, 0.5 * band, root_edge) *
+                                 std::clamp(0.45 + 0.8 * noise(fa * 0.1, along * 0.08, 21.0), 0.0, 1.0);
+            if (hash(i, j, 113) > grows) continue;
+            const double cover = (1.0 - glm::smoothstep(half, half + 0.2, off)) * (1.0 - glm::smoothstep(0.75, 1.0, t));
+            clear *= 1.0 - 0.85 * cover;
+            // Fine hairs are lighter at their tips and the outermost lighter still.
+            const double shade = (0.8 + 0.4 * hash(i, j, 127)) * (1.0 + 0.3 * t) * (1.2 - 0.2 * grows);
+            sum = {sum.r + hair_colour.r * shade * cover, sum.g + hair_colour.g * shade * cover,
+                   sum.b + hair_colour.b * shade * cover};
+            weight += cover;
+        }
+    const double fine = 1.0 - clear;
+    if (fine > 0.0) *colour = blend(*colour, sum * (1.0 / weight), fine * (1.0 - density));
+    return std::clamp(1.0 - (1.0 - density) * (1.0 - fine), 0.0, 1.0);
 }
 
 // Redness: haemoglobin absorbs green and blue, so a redder patch keeps its
 // red and loses some of both. `amount` 1 is the strongest flush painted.
 Rgb redden(Rgb c, double amount) {
-    return blend(c, c * Rgb{1.02, 0.83, 0.85}, std::clamp(amount, -0.5, 1.5));
+    return blend(c, c * Rgb{1.02, 0.84, 0.83}, std::clamp(amount, -0.5, 1.5));
 }
 // A soft elliptical field, 1 at (cx, cy) falling off as a Gaussian of
 // widths sx, sy (mm): regions of colour with no edge to see.
@@ -301,11 +365,31 @@ Texel Painter::skin(glm::dvec3 q) const {
     // Gentle pigment variation at two scales (MATTS: even skin reads young,
     // so it stays within a few percent), and haemoglobin mottling apart from
     // it so the two do not move together.
-    Rgb c = skin * (1.0 - al.pigment_variation * 0.5 + al.pigment_variation * fbm(q.x * 0.08, q.y * 0.08, q.z * 0.08));
-    c = redden(c, al.mottling * (fbm(q.x * 0.21 + 11.0, q.y * 0.21, q.z * 0.21) - 0.45));
+    // Both have a broad component (tens of mm: the blotchiness seen at a
+    // glance) under the finer one.
+    const double pigment = 0.6 * fbm(q.x * 0.08, q.y * 0.08, q.z * 0.08) + 0.4 * noise(q.x * 0.03, q.y * 0.03, q.z * 0.03 + 21.0);
+    Rgb c = skin * (1.0 + al.pigment_variation * (pigment - 0.5));
+    const double blood = 0.55 * fbm(q.x * 0.21 + 11.0, q.y * 0.21, q.z * 0.21) + 0.45 * noise(q.x * 0.06, q.y * 0.06, q.z * 0.06 + 23.0);
+    c = redden(c, al.mottling * (blood - 0.45));
     const double ax = std::abs(q.x);
-    const bool front = q.z > 45.0;
-    if (front) {
+    // Forehead: a shade darker and more yellow.
+    c = tint(c, al.forehead_tint, al.forehead_amount * glm::smoothstep(18.0, 45.0, q.y));
+    // Beard zone (shaved): below a line from the sideburn to the mouth
+    // corner, round the jaw to below the ear, fading on the neck; the
+    // stubble's dots under the skin make it grainy at the fine scale.
+    {
+        const double cheek_line = ax < 28.0 ? -46.0 : mix(-46.0, -14.0, std::min((ax - 28.0) / 34.0, 1.0));
+        const double beard = glm::smoothstep(3.0, -9.0, q.y - cheek_line + 4.0 * (noise(q.x * 0.15, q.y * 0.15, 31.0) - 0.5)) *
+                             glm::smoothstep(-150.0, -118.0, q.y) * glm::smoothstep(p_.sideburn_z - 25.0, p_.sideburn_z - 5.0, q.z) *
+                             (0.75 + 0.5 * noise(q.x * 1.7, q.y * 1.7, q.z * 1.7));
+        c = tint(c, al.beard_tint, al.beard_amount * beard);
+    }
+    // The face's own colouring (redness, freckles, lids, lips, brows) fades
+    // in towards the front instead of starting at a cut.
+    const double front = glm::smoothstep(36.0, 56.0, q.z);
+    if (front > 0.0) {
+        const Rgb side_colour = c;
+        const double side_gloss = gloss;
         // Regional redness: broad fields whose strength is broken up by
         // large noise and carried by a fine capillary texture.
         const double breakup = 1.0 - al.flush_breakup + 2.0 * al.flush_breakup * noise(q.x * 0.07, q.y * 0.07, 4.0);
@@ -314,8 +398,6 @@ Texel Painter::skin(glm::dvec3 q) const {
         for (const auto& f : al.flush)
             flush += f.amount * field(f.centre[0] == 0.0 ? q.x : ax, q.y, f.centre[0], f.centre[1], f.size[0], f.size[1]);
         c = redden(c, flush * breakup * capillaries);
-        // Forehead: a shade darker and more yellow.
-        c = tint(c, al.forehead_tint, al.forehead_amount * glm::smoothstep(18.0, 45.0, q.y));
         // Freckles: one candidate per cell of a jittered grid, over the nose
         // and cheeks mostly.
         {
@@ -338,13 +420,6 @@ Texel Painter::skin(glm::dvec3 q) const {
         const double eye_x = p_.eye_centre[0], eye_y = p_.eye_centre[1];
         const double orbit = field(ax, q.y, eye_x - 3.0, eye_y - 6.0, 11.0, 5.5) + 0.5 * field(ax, q.y, eye_x, eye_y + 3.0, 12.0, 6.0);
         c = tint(c, al.periorbital_tint, al.periorbital_amount * std::min(orbit, 1.0));
-
-        // Beard zone (shaved): below a line from the sideburn to the mouth
-        // corner, fading on the neck.
-        const double cheek_line = ax < 28.0 ? -46.0 : mix(-46.0, -14.0, std::min((ax - 28.0) / 34.0, 1.0));
-        const double beard = glm::smoothstep(2.0, -10.0, q.y - cheek_line) * glm::smoothstep(-150.0, -118.0, q.y) *
-                             (0.8 + 0.4 * noise(q.x * 1.7, q.y * 1.7, q.z * 1.7));
-        c = tint(c, al.beard_tint, al.beard_amount * beard);
 
         // T-zone: forehead centre and nose are oilier (glossier).
         const double t_zone = std::max(field(q.x, q.y, 0.0, 40.0, 22.0, 18.0), field(q.x, q.y, 0.0, -20.0, 9.0, 24.0));
@@ -424,7 +499,7 @@ Texel Painter::skin(glm::dvec3 q) const {
         if (q.y > 0 && q.y < 40 && ax < 65) {
             const BrowPlace b = brow_place(q.x, q.y);
             const double d = brow_density(b);
-            if (d > 0) c = blend(c, c * Rgb{0.8, 0.76, 0.74}, 0.35 * d);
+            if (d > 0) c = blend(c, c * Rgb{0.84, 0.8, 0.78}, 0.25 * d);
             Rgb hc;
             const double cover = brow_hairs(q.x, q.y, &hc);
             if (cover > 0) c = blend(c, hc, cover);
@@ -432,12 +507,16 @@ Texel Painter::skin(glm::dvec3 q) const {
         // Nostrils.
         const double n = s_.nostril_amount(q.x, q.y);
         if (n > 0) c = blend(c, Rgb{0.25, 0.12, 0.11}, glm::smoothstep(0.05, 0.5, n));
+        c = blend(side_colour, c, front);
+        gloss = mix(side_gloss, gloss, front);
     }
     // Ears: thin, well perfused, redder than the face beside them.
     if (ax > 55.0 && s_.ear_relief(q.y, q.z) > 0.0)
         c = redden(c, al.ear_flush * std::min(1.0, s_.ear_relief(q.y, q.z) / 3.0));
     Rgb hc;
-    const double h = hair(q, &hc);
+    double roots = 0.0;
+    const double h = hair(q, &hc, &roots);
+    if (roots > 0) c = tint(c, al.fine_hairs.roots_tint, al.fine_hairs.roots_amount * roots);
     if (h > 0) {
         c = blend(c, hc, h);
         gloss = mix(gloss, 1.0, h);
@@ -488,7 +567,7 @@ Image paint_base_colour(const FaceShape& shape, const TriMesh& mesh, int size) {
     img.width = img.height = size;
     img.rgba.assign(static_cast<std::size_t>(size) * size * 4, 0);
     std::vector<std::uint8_t> filled(static_cast<std::size_t>(size) * size, 0);
-    Painter painter(shape);
+    const Painter painter(shape);
     auto put = [&](int x, int y, Rgb c, double gloss) {
         const std::size_t i = static_cast<std::size_t>(y) * size + x;
         auto to8 = [](double v) { return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0)); };
@@ -499,65 +578,97 @@ Image paint_base_colour(const FaceShape& shape, const TriMesh& mesh, int size) {
         filled[i] = 1;
     };
 
-    for (auto fh : mesh.faces()) {
+    // The triangles in texel coordinates, and which bands of rows each
+    // touches: bands are painted in parallel, each by one thread, every
+    // band's triangles in mesh order, so the image does not depend on the
+    // thread count.
+    struct Triangle {
         double tu[3], tv[3];
         glm::dvec3 pos[3];
+        bool skin;
+        int y0, y1;
+    };
+    constexpr int kBandRows = 16;
+    const int bands = (size + kBandRows - 1) / kBandRows;
+    std::vector<Triangle> triangles;
+    triangles.reserve(mesh.n_faces());
+    std::vector<std::vector<int>> in_band(static_cast<std::size_t>(bands));
+    for (auto fh : mesh.faces()) {
+        Triangle t;
         int k = 0;
         for (auto vh : mesh.fv_range(fh)) {
-            const auto t = mesh.texcoord2D(vh);
+            const auto uv = mesh.texcoord2D(vh);
             const auto q = mesh.point(vh);
-            tu[k] = t[0] * size - 0.5;
-            tv[k] = (1.0 - t[1]) * size - 0.5;
-            pos[k] = {q[0], q[1], q[2]};
+            t.tu[k] = uv[0] * size - 0.5;
+            t.tv[k] = (1.0 - uv[1]) * size - 0.5;
+            t.pos[k] = {q[0], q[1], q[2]};
             ++k;
         }
-        const bool is_skin = std::min({tu[0], tu[1], tu[2]}) >= -1 &&
-                             (1.0 - (std::max({tv[0], tv[1], tv[2]}) + 0.5) / size) >= kSkinV0 - 1e-6;
-        const int x0 = std::max(0, static_cast<int>(std::floor(std::min({tu[0], tu[1], tu[2]}))));
-        const int x1 = std::min(size - 1, static_cast<int>(std::ceil(std::max({tu[0], tu[1], tu[2]}))));
-        const int y0 = std::max(0, static_cast<int>(std::floor(std::min({tv[0], tv[1], tv[2]}))));
-        const int y1 = std::min(size - 1, static_cast<int>(std::ceil(std::max({tv[0], tv[1], tv[2]}))));
-        const double area = (tu[1] - tu[0]) * (tv[2] - tv[0]) - (tu[2] - tu[0]) * (tv[1] - tv[0]);
-        if (std::abs(area) < 1e-12) continue;
-        for (int y = y0; y <= y1; ++y) {
-            for (int x = x0; x <= x1; ++x) {
-                const double w0 = ((tu[1] - x) * (tv[2] - y) - (tu[2] - x) * (tv[1] - y)) / area;
-                const double w1 = ((tu[2] - x) * (tv[0] - y) - (tu[0] - x) * (tv[2] - y)) / area;
-                const double w2 = 1.0 - w0 - w1;
-                constexpr double kEps = -1e-4;
-                if (w0 < kEps || w1 < kEps || w2 < kEps) continue;
-                if (is_skin) {
-                    const Texel t = painter.skin(pos[0] * w0 + pos[1] * w1 + pos[2] * w2);
-                    put(x, y, t.colour, t.gloss);
-                } else {
-                    put(x, y, painter.tile((x + 0.5) / size, 1.0 - (y + 0.5) / size), 1.0);
+        t.skin = std::min({t.tu[0], t.tu[1], t.tu[2]}) >= -1 &&
+                 (1.0 - (std::max({t.tv[0], t.tv[1], t.tv[2]}) + 0.5) / size) >= kSkinV0 - 1e-6;
+        t.y0 = std::max(0, static_cast<int>(std::floor(std::min({t.tv[0], t.tv[1], t.tv[2]}))));
+        t.y1 = std::min(size - 1, static_cast<int>(std::ceil(std::max({t.tv[0], t.tv[1], t.tv[2]}))));
+        if (t.y0 > t.y1) continue;
+        const int index = static_cast<int>(triangles.size());
+        triangles.push_back(t);
+        for (int b = t.y0 / kBandRows; b <= t.y1 / kBandRows; ++b) in_band[static_cast<std::size_t>(b)].push_back(index);
+    }
+    parallel_for(bands, 1, [&](int band_begin, int band_end) {
+        for (int band = band_begin; band < band_end; ++band) {
+            const int row0 = band * kBandRows, row1 = std::min(size - 1, row0 + kBandRows - 1);
+            for (int index : in_band[static_cast<std::size_t>(band)]) {
+                const Triangle& t = triangles[static_cast<std::size_t>(index)];
+                const double* tu = t.tu;
+                const double* tv = t.tv;
+                const int x0 = std::max(0, static_cast<int>(std::floor(std::min({tu[0], tu[1], tu[2]}))));
+                const int x1 = std::min(size - 1, static_cast<int>(std::ceil(std::max({tu[0], tu[1], tu[2]}))));
+                const double area = (tu[1] - tu[0]) * (tv[2] - tv[0]) - (tu[2] - tu[0]) * (tv[1] - tv[0]);
+                if (std::abs(area) < 1e-12) continue;
+                for (int y = std::max(t.y0, row0); y <= std::min(t.y1, row1); ++y) {
+                    for (int x = x0; x <= x1; ++x) {
+                        const double w0 = ((tu[1] - x) * (tv[2] - y) - (tu[2] - x) * (tv[1] - y)) / area;
+                        const double w1 = ((tu[2] - x) * (tv[0] - y) - (tu[0] - x) * (tv[2] - y)) / area;
+                        const double w2 = 1.0 - w0 - w1;
+                        constexpr double kEps = -1e-4;
+                        if (w0 < kEps || w1 < kEps || w2 < kEps) continue;
+                        if (t.skin) {
+                            const Texel texel = painter.skin(t.pos[0] * w0 + t.pos[1] * w1 + t.pos[2] * w2);
+                            put(x, y, texel.colour, texel.gloss);
+                        } else {
+                            put(x, y, painter.tile((x + 0.5) / size, 1.0 - (y + 0.5) / size), 1.0);
+                        }
+                    }
                 }
             }
         }
-    }
+    });
     // Grow the painted texels into the empty ones around them, so bilinear
-    // filtering and mipmaps near a chart's border never fetch black.
+    // filtering and mipmaps near a chart's border never fetch black. A pass
+    // reads only texels filled before it and writes only empty ones, so its
+    // rows can run in parallel.
     for (int pass = 0; pass < 8; ++pass) {
         std::vector<std::uint8_t> next = filled;
-        for (int y = 0; y < size; ++y) {
-            for (int x = 0; x < size; ++x) {
-                const std::size_t i = static_cast<std::size_t>(y) * size + x;
-                if (filled[i]) continue;
-                int sum[4] = {0, 0, 0, 0}, n = 0;
-                for (int dy = -1; dy <= 1; ++dy)
-                    for (int dx = -1; dx <= 1; ++dx) {
-                        const int xx = x + dx, yy = y + dy;
-                        if (xx < 0 || yy < 0 || xx >= size || yy >= size) continue;
-                        const std::size_t j = static_cast<std::size_t>(yy) * size + xx;
-                        if (!filled[j]) continue;
-                        for (int c = 0; c < 4; ++c) sum[c] += img.rgba[j * 4 + c];
-                        ++n;
-                    }
-                if (n == 0) continue;
-                for (int c = 0; c < 4; ++c) img.rgba[i * 4 + c] = static_cast<std::uint8_t>(sum[c] / n);
-                next[i] = 1;
+        parallel_for(size, kBandRows, [&](int row_begin, int row_end) {
+            for (int y = row_begin; y < row_end; ++y) {
+                for (int x = 0; x < size; ++x) {
+                    const std::size_t i = static_cast<std::size_t>(y) * size + x;
+                    if (filled[i]) continue;
+                    int sum[4] = {0, 0, 0, 0}, n = 0;
+                    for (int dy = -1; dy <= 1; ++dy)
+                        for (int dx = -1; dx <= 1; ++dx) {
+                            const int xx = x + dx, yy = y + dy;
+                            if (xx < 0 || yy < 0 || xx >= size || yy >= size) continue;
+                            const std::size_t j = static_cast<std::size_t>(yy) * size + xx;
+                            if (!filled[j]) continue;
+                            for (int c = 0; c < 4; ++c) sum[c] += img.rgba[j * 4 + c];
+                            ++n;
+                        }
+                    if (n == 0) continue;
+                    for (int c = 0; c < 4; ++c) img.rgba[i * 4 + c] = static_cast<std::uint8_t>(sum[c] / n);
+                    next[i] = 1;
+                }
             }
-        }
+        });
         filled.swap(next);
     }
     for (std::size_t i = 0; i < filled.size(); ++i)
