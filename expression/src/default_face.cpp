@@ -512,10 +512,19 @@ void Generator::build_lashes(Face& face, int side, bool upper) {
     std::mt19937 random(static_cast<unsigned>(1 + 2 * side + (upper ? 0 : 1)));
     auto uniform = [&] { return static_cast<double>(random()) / 4294967296.0; };
     constexpr int kSections = 4;
+    // Lashes grow in clumps of about four whose tips lean together (a comb
+    // of evenly spaced, parallel lashes read as spiky): a clump's tips are
+    // pulled towards its middle root by kClumpPull of the gap.
+    constexpr int kClump = 4;
+    constexpr double kClumpPull = 0.85;
     const double u0 = detail::tile_u0(detail::Tile::Eye);
+    auto root_s = [&](double k) { return 0.05 + 0.9 * (k + 0.5) / row.count; };
     for (int k = 0; k < row.count; ++k) {
         // Where along the margin (0 inner corner, 1 outer), clear of the corners.
         const double s = 0.05 + 0.9 * (k + 0.5 + 0.8 * (uniform() - 0.5)) / row.count;
+        const int clump_first = k - k % kClump;
+        const double clump_s = root_s(clump_first + 0.5 * (std::min(kClump, row.count - clump_first) - 1));
+        const double pull = kClumpPull * (clump_s - s) * arc.back();
         const double at = s * arc.back();
         std::size_t i = 1;
         while (i + 1 < arc.size() && arc[i] < at) ++i;
@@ -546,8 +555,9 @@ void Generator::build_lashes(Face& face, int side, bool upper) {
             const double half = 0.5 * row.width * (1.0 - 0.8 * f);
             const glm::dvec3 side_dir = detail::normalised(along - dir * glm::dot(along, dir));
             const double u = u0 + detail::kTile * (0.02 + 0.06 * f);
-            add_vertex(face, p - side_dir * half, u, detail::kTile * 0.02, VertexPart::Skin);
-            add_vertex(face, p + side_dir * half, u, detail::kTile * 0.08, VertexPart::Skin);
+            const glm::dvec3 q = p + along * (pull * f * f);
+            add_vertex(face, q - side_dir * half, u, detail::kTile * 0.02, VertexPart::Skin);
+            add_vertex(face, q + side_dir * half, u, detail::kTile * 0.08, VertexPart::Skin);
             if (c + 1 < kSections) {
                 const double g = (c + 0.5) / (kSections - 1);
                 const double mid = lift + curl * g * g;
