@@ -81,8 +81,14 @@ bool looks_like_csv(std::string_view text) {
     Lines lines(skip_bom(text));
     std::string_view line;
     long long number = 0;
-    while (lines.next(line, number))
-        if (!trim(line).empty()) return line.find(',') != std::string_view::npos;
+    // A FAP file's comments ('#') may hold commas, and so may its header's
+    // name, but that header starts with its version number; a capture CSV
+    // starts with a header of names.
+    while (lines.next(line, number)) {
+        const std::string_view content = trim(line);
+        if (content.empty() || content[0] == '#') continue;
+        return content.find(',') != std::string_view::npos && !(content[0] >= '0' && content[0] <= '9');
+    }
     return false;
 }
 

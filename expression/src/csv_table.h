@@ -30,7 +30,8 @@ struct CsvTable {
     [[noreturn]] void fail(long long line, std::string_view expected, std::string_view found) const;
 };
 
-// Whether the first non-blank line of `text` has a comma (a CSV, not a FAP file).
+// Whether `text` is a CSV rather than a FAP file: its first line that is
+// neither blank nor a '#' comment has a comma and does not start with a digit.
 bool looks_like_csv(std::string_view text);
 
 // The table; rows with a field count other than the header's are an error

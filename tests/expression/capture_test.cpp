@@ -279,10 +279,12 @@ TEST(AnimationFile, AFapFileIsReadAsOne) {
     std::string mask;
     for (int i = 0; i < 68; ++i) mask += i == 2 ? "1 " : "0 ";
     ex::AnimationFormat format = ex::AnimationFormat::OpenFace;
-    const fap::FapStream s = parse("2.1 t 25 1\n" + mask + "\n0 120\n", &format);
+    // Commas in its comments and its name do not make it a CSV.
+    const fap::FapStream s = parse("# joy, then anger\n2.1 a, b 25 1\n" + mask + "\n0 120\n", &format);
     EXPECT_EQ(format, ex::AnimationFormat::Fap);
     ASSERT_EQ(s.frames.size(), 1u);
     EXPECT_EQ(s.frames[0].get(3), 120);
+    EXPECT_EQ(s.name, "a, b");
 }
 
 TEST(ArkitTable, EveryShapeMovesTheFaceAndLeftMirrorsRight) {

@@ -20,8 +20,10 @@
 // interval between rows, whole when within 1 % of a whole number), values
 // interpolated linearly between the rows around each frame's time.
 //
-// The format is told from the content: a first line with commas is a CSV,
-// recognised by its header; anything else is read as a FAP file. A CSV that
+// The format is told from the content: a first line (past blank lines and
+// '#' comments) with commas that does not start with a digit (a FAP header
+// starts with its version) is a CSV, recognised by its header; anything else
+// is read as a FAP file. A CSV that
 // is none of the three says which it resembles most and the columns it
 // lacks. Every error is emoface::InputError
 // "capture: FILE:LINE: expected ..., found ..." (FAP files: "fap: ...").
