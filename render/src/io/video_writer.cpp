@@ -148,9 +148,14 @@ public:
             bad("a sound file FFmpeg reads", av_error(r));
         const AVCodec* decoder = nullptr;
         stream_ = av_find_best_stream(input_.get(), AVMEDIA_TYPE_AUDIO, -1, -1, &decoder, 0);
-        if (stream_ == AVERROR_STREAM_NOT_FOUND)
-            bad("a sound stream", fmt::format("none in its {} streams ({})", input_->nb_streams,
-                                              input_->iformat->name));
+        if (stream_ == AVERROR_STREAM_NOT_FOUND) {
+            std::string kinds;
+            for (unsigned i = 0; i < input_->nb_streams; ++i) {
+                const char* kind = av_get_media_type_string(input_->streams[i]->codecpar->codec_type);
+                kinds += (i ? ", " : "") + std::string(kind ? kind : "unknown");
+            }
+            bad("a sound stream", kinds.empty() ? "no streams" : fmt::format("none (streams: {})", kinds));
+        }
         if (stream_ < 0 || !decoder)
             bad("a sound stream FFmpeg decodes",
                 fmt::format("{} with no decoder here",
