@@ -149,8 +149,9 @@ int main(int argc, char** argv) {
         so.backend = backend;
         so.frames = frames_name == "shader" ? render::WrinkleFrames::Shader : render::WrinkleFrames::Mesh;
         so.morph.accuracy = accuracy == "fast" ? morph::Accuracy::Fast : morph::Accuracy::Exact;
-        so.gpu_geometry = geometry == "gpu" || (geometry == "auto" && backend != morph::Backend::Cpu &&
-                                                 render::cuda_geometry_available());
+        so.geometry = geometry == "gpu"   ? render::GeometryDevice::Gpu
+                      : geometry == "cpu" ? render::GeometryDevice::Cpu
+                                          : render::GeometryDevice::Auto;
         t = Clock::now();
         render::FaceScene scene(platform, face, *assets->rig, assets->keys, assets->lines, so);
         const double scene_ms = ms(Clock::now() - t);

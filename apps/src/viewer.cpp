@@ -27,6 +27,7 @@
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <glm/geometric.hpp>
 #include <spdlog/spdlog.h>
 
 #define GLFW_INCLUDE_NONE
@@ -356,18 +357,15 @@ private:
         const ImVec2 scale(io.DisplayFramebufferScale.x > 0 ? 1.0f / io.DisplayFramebufferScale.x : 1.0f,
                            io.DisplayFramebufferScale.y > 0 ? 1.0f / io.DisplayFramebufferScale.y : 1.0f);
         const auto& face = session_.assets().face;
-        const auto& mesh = session_.scene().mesh();
+        const auto& scene = session_.scene();
         const glm::vec3 eye = camera_.eye();
         std::array<bool, expression::kFeatureCount> visible{};
         for (std::size_t i = 0; i < screen.size(); ++i) {
             if (!screen[i]) continue;
             const int v = face.feature_points[i].vertex;
-            if (v >= 0 && v < int(mesh.n_vertices()) && mesh.has_vertex_normals()) {
-                const auto vh = mesh.vertex_handle(unsigned(v));
-                const auto n = mesh.normal(vh);
-                const auto p = mesh.point(vh);
-                const glm::vec3 to_eye = eye - glm::vec3(p[0], p[1], p[2]);
-                visible[i] = n[0] * to_eye.x + n[1] * to_eye.y + n[2] * to_eye.z > 0.0f;
+            if (v >= 0 && v < int(scene.mesh().n_vertices())) {
+                const auto s = scene.surface_point(v);  // posed on either geometry device
+                visible[i] = glm::dot(s.normal, eye - s.position) > 0.0f;
             } else {
                 visible[i] = true;
             }

@@ -266,7 +266,10 @@ FaceScene::FaceScene(Platform& platform, const expression::Face& face,
             renderer_->update_mesh(part.id, part.mesh, part.wrinkle_uvs, part.fixed_tangents);
     }
 
-    if (options.gpu_geometry) {
+    const bool gpu_geometry =
+        options.geometry == GeometryDevice::Gpu ||
+        (options.geometry == GeometryDevice::Auto && wrinkle_morph_->uses_interop() && cuda_geometry_available());
+    if (gpu_geometry) {
         // The parts' vertex buffers, written by the GPU from now on.
         std::vector<GeometryPart> geometry_parts;
         std::vector<unsigned> buffers;
@@ -338,7 +341,8 @@ void* FaceScene::geometry_stream() const { return cuda_geometry_ ? cuda_geometry
 
 void FaceScene::deform_on_gpu(const expression::FapValues& faps, bool layout_from_mesh) {
     const auto t = Clock::now();
-    const expression::RigFrame frame = rig_.frame(faps);
+    frame_ = rig_.frame(faps);
+    const expression::RigFrame& frame = frame_;
     if (layout_from_mesh && layout_kind_ == WrinkleLayout::Projective) {
         layout_ = layout_of(rig_.feature_points(frame), present_points(face_), box_);
         target_ = to_morph_layout(expression::layout_segments(lines_, layout_));
@@ -355,6 +359,34 @@ void FaceScene::deform_on_gpu(const expression::FapValues& faps, bool layout_fro
     geometry_buffers_->unmap(stream);
     times_.rig_ms = ms_since(t);  // host time: parameters, map, launches, unmap
     times_.uv_ms = times_.tangents_ms = times_.upload_ms = 0.0;
+}
+
+FaceScene::SurfacePoint FaceScene::surface_point(int vertex) const {
+    if (vertex < 0 || vertex >= int(mesh_.n_vertices()))
+        fail("render: FaceScene::surface_point(): expected a vertex below {}, found {}", mesh_.n_vertices(), vertex);
+    const auto vh = mesh_.vertex_handle(unsigned(vertex));
+    if (!cuda_geometry_) {
+        const auto p = mesh_.point(vh);
+        const auto n = mesh_.normal(vh);
+        return {glm::vec3(p[0], p[1], p[2]), glm::vec3(n[0], n[1], n[2])};
+    }
+    // The GPU posed the vertex buffers only: the rig's body again here for
+    // the vertex and its one-ring, the normal as the kernels make it (the
+    // unit sum of the faces' unit normals).
+    const expression::RigView rig = rig_.view();
+    auto posed = [&](OpenMesh::VertexHandle v) {
+        const auto p = expression::rig_kernel::position(rig, frame_, v.idx());
+        return geometry_kernel::V3{p.x, p.y, p.z};
+    };
+    geometry_kernel::V3 sum{0, 0, 0};
+    for (const auto fh : mesh_.vf_range(vh)) {
+        geometry_kernel::V3 c[3];
+        int i = 0;
+        for (const auto v : mesh_.fv_range(fh)) c[i++] = posed(v);
+        sum = sum + geometry_kernel::face_normal(c[0], c[1], c[2]);
+    }
+    const geometry_kernel::V3 p = posed(vh), n = geometry_kernel::unit_normal(sum);
+    return {glm::vec3(p.x, p.y, p.z), glm::vec3(n.x, n.y, n.z)};
 }
 
 void FaceScene::deform(const expression::FapValues& faps, bool layout_from_mesh) {

@@ -1,6 +1,8 @@
 // CudaGeometry (the rig, normals, wrinkle UVs and tangent frames on the GPU)
 // against its CPU twin FaceGeometry::compute, on the default face in frames
-// that move every stage of the rig. Skips without a CUDA device.
+// that move every stage of the rig; and a FaceScene on a CUDA machine takes
+// the GPU geometry by default and still answers surface_point() as the CPU
+// geometry's posed mesh does. Skips without a CUDA device.
 #include <gtest/gtest.h>
 
 #include <cuda_runtime.h>
@@ -8,6 +10,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include <glm/geometric.hpp>
+
+#include "emoface/render/face_assets.h"
+#include "emoface/render/face_scene.h"
 #include "face_geometry_cases.h"
 
 namespace emoface::render {
@@ -59,6 +65,52 @@ TEST(CudaGeometry, MatchesTheCpuTwin) {
     }
     for (float* s : shape_d) cudaFree(s);
     for (float* f : frame_d) cudaFree(f);
+}
+
+TEST(FaceSceneGeometry, GpuByDefaultWithTheSurfaceOfTheCpuGeometry) {
+    if (!cuda_geometry_available()) GTEST_SKIP() << "no CUDA device: the GPU geometry is not tested here";
+    FaceAssetsOptions ao;
+    ao.face.resolution_scale = 0.5;
+    ao.face.texture_size = 256;
+    ao.wrinkle_map_size = 256;
+    const auto assets = load_default_face_assets(EMOFACE_DATA_DIR, ao);
+    PlatformOptions po;
+    po.width = po.height = 64;
+    po.cuda_device = 0;
+    HeadlessPlatform platform(po);
+    FaceSceneOptions gpu_options;  // geometry: Auto
+    gpu_options.backend = morph::Backend::Cuda;
+    const auto gpu = make_face_scene(platform, *assets, gpu_options);
+    if (!gpu->uses_interop()) GTEST_SKIP() << "the GL context is not on the CUDA device: no interop";
+    EXPECT_TRUE(gpu->uses_gpu_geometry()) << "a CUDA morph through interop takes the GPU geometry by default";
+    FaceSceneOptions cpu_options;
+    cpu_options.backend = morph::Backend::Cpu;
+    const auto cpu = make_face_scene(platform, *assets, cpu_options);
+    EXPECT_FALSE(cpu->uses_gpu_geometry()) << "the CPU morph keeps the geometry on the CPU";
+
+    std::vector<float> weights(std::size_t(gpu->key_count()), 0.0f);
+    weights[0] = 1.0f;
+    for (const NamedFaps& named : frames()) {
+        gpu->update(named.faps, weights);
+        cpu->update(named.faps, weights);
+        int checked = 0;
+        float worst_position = 0, worst_normal = 0, moved = 0;
+        for (const auto& fp : assets->face.feature_points) {
+            if (!fp.present || fp.vertex < 0) continue;
+            const FaceScene::SurfacePoint g = gpu->surface_point(fp.vertex), c = cpu->surface_point(fp.vertex);
+            worst_position = std::max(worst_position, glm::length(g.position - c.position));
+            worst_normal = std::max(worst_normal, glm::length(g.normal - c.normal));
+            // The GPU scene's host mesh stays neutral: the posed point is not read from it.
+            const auto n = gpu->mesh().point(gpu->mesh().vertex_handle(unsigned(fp.vertex)));
+            moved = std::max(moved, glm::length(g.position - glm::vec3(n[0], n[1], n[2])));
+            ++checked;
+        }
+        EXPECT_GT(checked, 40) << named.name;
+        // The same rig body in float; OpenMesh's normals from the same points.
+        EXPECT_LE(worst_position, 1e-4f) << named.name;
+        EXPECT_LE(worst_normal, 1e-3f) << named.name;
+        if (named.name != "neutral") EXPECT_GT(moved, 1e-3f) << named.name << ": the feature points did not move";
+    }
 }
 
 }  // namespace

@@ -92,6 +92,8 @@ enum class WrinkleFrames {
     Shader,
 };
 
+enum class GeometryDevice { Auto, Cpu, Gpu };
+
 struct FaceSceneOptions {
     morph::Backend backend = morph::Backend::Auto;
     WrinkleFrames frames = WrinkleFrames::Mesh;
@@ -102,12 +104,15 @@ struct FaceSceneOptions {
     Material skin{};  // base_texture: the face's base colour unless set
     Material eyes{};
     Material mouth{};
-    // The rig, vertex normals, wrinkle UVs and tangent frames on the GPU
-    // (face_geometry.h: the CPU path's kernel bodies), written straight
-    // into the vertex buffers through CUDA-GL interop; per frame only the
-    // rig's parameters leave the host. Needs a CUDA device sharing the GL
-    // context; mesh() then stays at the neutral pose.
-    bool gpu_geometry = false;
+    // Where the rig, vertex normals, wrinkle UVs and tangent frames run.
+    // Gpu: face_geometry.h's CudaGeometry (the CPU path's kernel bodies),
+    // written straight into the vertex buffers through CUDA-GL interop; per
+    // frame only the rig's parameters leave the host; mesh() then stays at
+    // the neutral pose (surface_point() gives the posed surface). Needs a
+    // CUDA device sharing the GL context. Auto: the GPU exactly when the
+    // morph runs on CUDA through interop (so the GL context is on a CUDA
+    // device), else the CPU.
+    GeometryDevice geometry = GeometryDevice::Auto;
     FaceSceneOptions();
 };
 
@@ -166,7 +171,16 @@ public:
     // The geometry the GPU runs (null without it).
     const FaceGeometry* geometry() const { return geometry_.get(); }
     int key_count() const;
+    // The full mesh: posed with the CPU geometry, neutral with the GPU's.
     const expression::TriMesh& mesh() const { return mesh_; }
+    // A vertex of the full mesh as the last frame posed it (its position and
+    // unit vertex normal), on either geometry device: with the GPU's it is
+    // computed on the host from the vertex's one-ring (the rig's kernel body
+    // over a few vertices), for the few vertices a caller asks for.
+    struct SurfacePoint {
+        glm::vec3 position, normal;
+    };
+    SurfacePoint surface_point(int vertex) const;
     const expression::FeatureLayout& layout() const { return layout_; }
     WrinkleLayout layout_kind() const { return layout_kind_; }
     // L* as the morph takes it (one line per feature line), and its parameters.
@@ -201,6 +215,7 @@ private:
     morph::MorphParams params_;
     WrinkleFrames frames_;
     FrameStageTimes times_;
+    expression::RigFrame frame_;  // the last frame's rig parameters (GPU geometry)
     std::unique_ptr<FaceGeometry> geometry_;
     std::unique_ptr<CudaGeometry> cuda_geometry_;
     std::unique_ptr<GlBufferInterop> geometry_buffers_;
