@@ -44,9 +44,6 @@ Camera Camera::frontal(const glm::vec3& box_min, const glm::vec3& box_max, float
 
 namespace {
 
-// Triangles sorted together for the draw order (add_mesh).
-constexpr std::size_t kDrawCluster = 64;
-
 // Per-vertex data that changes every frame, in two buffers: the shape, and
 // the wrinkle map's frame (not needed when the shader derives it).
 struct ShapeVertex {
@@ -354,33 +351,6 @@ Renderer::MeshId Renderer::add_mesh(const expression::TriMesh& mesh, const Mater
             fail("render: Renderer::add_mesh(): face {} has {} vertices, expected a triangle",
                  fh.idx(), k);
         indices.insert(indices.end(), tri, tri + 3);
-    }
-    // Nearest the frontal camera (+z) first, so the depth test rejects the
-    // back of the head, the neck behind the chin and the like before they
-    // are shaded. Runs of kDrawCluster triangles in the mesh's order are
-    // sorted by their mean depth, not single triangles: neighbours stay
-    // together and share their transformed vertices.
-    {
-        const std::size_t triangles = indices.size() / 3;
-        const std::size_t clusters = (triangles + kDrawCluster - 1) / kDrawCluster;
-        std::vector<float> depth(clusters, 0.0f);
-        std::vector<std::uint32_t> order(clusters);
-        for (std::size_t t = 0; t < triangles; ++t)
-            for (int c = 0; c < 3; ++c)
-                depth[t / kDrawCluster] += mesh.point(mesh.vertex_handle(int(indices[3 * t + std::size_t(c)])))[2];
-        for (std::size_t k = 0; k < clusters; ++k) {
-            order[k] = std::uint32_t(k);
-            depth[k] /= float(std::min(kDrawCluster, triangles - k * kDrawCluster));
-        }
-        std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return depth[a] > depth[b]; });
-        std::vector<std::uint32_t> sorted;
-        sorted.reserve(indices.size());
-        for (const std::uint32_t k : order) {
-            const std::size_t begin = 3 * std::size_t(k) * kDrawCluster;
-            const std::size_t end = std::min(indices.size(), begin + 3 * kDrawCluster);
-            sorted.insert(sorted.end(), indices.begin() + std::ptrdiff_t(begin), indices.begin() + std::ptrdiff_t(end));
-        }
-        indices.swap(sorted);
     }
     m.index_count = GLsizei(indices.size());
     m.base_uvs.assign(m.vertex_count, glm::vec2(0.0f));

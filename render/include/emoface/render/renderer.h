@@ -123,9 +123,7 @@ public:
     Renderer& operator=(const Renderer&) = delete;
 
     // Uploads a mesh's topology and base UVs and its current shape (with the
-    // base UVs as wrinkle UVs). Meshes are drawn in the order added; a mesh's
-    // triangles nearest the +z side first (the frontal camera's view: what
-    // they hide is then rejected by the depth test before it is shaded).
+    // base UVs as wrinkle UVs). Meshes are drawn in the order added.
     MeshId add_mesh(const expression::TriMesh& mesh, const Material& material);
 
     // The mesh's new shape (points, vertex normals) and wrinkle UVs (one per
