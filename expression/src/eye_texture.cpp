@@ -55,7 +55,12 @@ std::array<double, 3> eye_colour(const FaceShape& shape, double polar, double az
     Rgb sclera = from255(p.sclera);
     const double corner = glm::smoothstep(ai + 0.1, 1.25, polar) * std::pow(std::cos(azimuth), 2);
     sclera = blend(sclera, tinted(sclera, {0.95, 0.82, 0.80}), p.sclera_corner_tint * corner);
-    sclera = blend(sclera, tinted(sclera, {0.80, 0.30, 0.30}), p.sclera_vessels * vessels(polar, azimuth, R, ai));
+    // Past about 100 degrees from the front pole the eyeball never shows
+    // between the lids, whichever way it turns: no vessels there (they are
+    // most of the eye tile's cost).
+    const double shown = 1.0 - glm::smoothstep(1.6, 1.8, polar);
+    if (shown > 0.0)
+        sclera = blend(sclera, tinted(sclera, {0.80, 0.30, 0.30}), p.sclera_vessels * shown * vessels(polar, azimuth, R, ai));
     sclera = scaled(sclera, 1.0 - 0.25 * glm::smoothstep(0.3 * kPi, 0.8 * kPi, polar));
 
     Rgb c = sclera;
