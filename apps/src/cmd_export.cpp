@@ -9,17 +9,21 @@
 //    base-colour UVs and one material whose base colour is the face's
 //    texture, embedded as PNG;
 //  - morph targets, named in mesh.extras.targetNames:
-//      FAPnn_<name> for every low-level FAP that moves this face: the rig's
-//        motion at the FAP's reference value `fapScale` (mesh.extras), so a
-//        FAP value v is the weight v / fapScale. The point field is linear in
-//        the FAPs, so these are exact there; rotations (jaw, eyes, head) and
-//        the lids sliding over the eyeballs are linearised about neutral by a
-//        central difference (README, "glTF": the error this leaves);
+//      FAPnn_<name> for every low-level FAP with a non-rigid motion: the
+//        rig's point field, lids, slides, lashes and pupils at the FAP's
+//        reference value `fapScale` (mesh.extras), so a FAP value v is the
+//        weight v / fapScale. The point field is linear in the FAPs, so
+//        these are exact there; the lids' slide over the eyeballs and the
+//        lashes' turn are linearised about neutral (the error this leaves:
+//        README, "glTF");
+//      the jaw, eyes and head as skin joints: the rig blends them into each
+//        vertex with a weight (blend_rigid), which is linear blend skinning;
 //      AUn, the six emotions, the 14 visemes and the 52 ARKit shapes (ARKit's
 //        own names): each the sum of its FAPs' targets, so an engine that
 //        drives ARKit shapes or AUs drives this face;
 //  - with an animation: its frames as one glTF animation of the morph
-//    weights (the FAP targets) at the file's own times, FAPs clamped to the
+//    weights (the FAP targets) and the joints' rotations and translations
+//    (RigFrame) at the file's own times, FAPs clamped to the
 //    face's ranges as the rig clamps them.
 #include <algorithm>
 #include <cmath>
