@@ -38,7 +38,7 @@ using emoface::testing::CommandResult;
 using emoface::testing::run_emoface;
 
 const std::string kData = EMOFACE_DATA_DIR;
-const std::string kRealFap = "/work/shared/realdata/fap";
+const std::string kRealFap = std::string(EMOFACE_REALDATA_DIR) + "/fap";
 // A coarser mesh keeps the test fast; the rig and the export are the same code at any resolution.
 const std::string kResolution = "0.5";
 
