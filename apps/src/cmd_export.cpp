@@ -319,12 +319,7 @@ void export_gltf(const ExportArgs& a) {
     // The weights of a frame: its FAPs as the rig takes them (clamped; a lip
     // contour left at 0 moves with the other).
     auto weights_of = [&](const ex::FapValues& raw) {
-        ex::FapValues f = ro.ranges.clamp(raw);
-        for (int inner = 4; inner <= 13; ++inner) {
-            double &x = f[inner - 1], &y = f[inner + 47 - 1];
-            if (x == 0.0) x = y;
-            else if (y == 0.0) y = x;
-        }
+        const ex::FapValues f = ex::lip_contours_together(ro.ranges.clamp(raw));
         std::vector<float> w(names.size(), 0.0f);
         for (int n = 3; n <= emoface::fap::kFapCount; ++n)
             if (target_of_fap[n] >= 0) w[target_of_fap[n]] = static_cast<float>(f[n - 1] / scale_of_fap[n]);

@@ -92,10 +92,11 @@ bool margin_y(const std::vector<std::array<double, 2>>& m, double x, double* y) 
     return false;
 }
 
-// The inner and outer lip contours are the two edges of one vermilion: a
-// frame that moves one contour and leaves its partner FAP at 0 (vreng's
-// files send only the outer FAPs 51-60) moves both, or the corners, where
-// the contours lie 2 mm apart, tear into a stitch.
+
+}  // namespace
+
+// Both contours move: the corners, where they lie 2 mm apart, would tear
+// into a stitch if one moved alone (vreng's files send only FAPs 51-60).
 FapValues lip_contours_together(FapValues faps) {
     for (int inner = 4; inner <= 13; ++inner) {
         double& a = faps[inner - 1];
@@ -105,8 +106,6 @@ FapValues lip_contours_together(FapValues faps) {
     }
     return faps;
 }
-
-}  // namespace
 
 FapRanges::FapRanges() {
     lower.fill(-std::numeric_limits<double>::infinity());

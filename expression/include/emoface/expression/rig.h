@@ -55,6 +55,11 @@ struct FapRanges {
     FapValues clamp(const FapValues& faps, int* clamped = nullptr) const;
 };
 
+// The inner and outer lip contours (FAPs 4-13 and 51-60) are the two edges
+// of one vermilion: in the returned values a contour the frame leaves at 0
+// takes its partner's value. The rig applies this to every frame.
+FapValues lip_contours_together(FapValues faps);
+
 // Reads {"faps": {FAP name: {"range": [min, max], "why": text}}} with every
 // low-level FAP named once; throws emoface::InputError naming the file and
 // key for a missing or unknown FAP, or a range with min > 0 or max < 0.
