@@ -99,6 +99,11 @@ void check_order(const CsvTable& t, const CsvRow& row, const std::vector<Sample>
 
 // Constant-rate frames over the samples' span: fps from the median interval.
 fap::FapStream resample(const Capture& c, const std::string& source, const CsvTable& t) {
+    // Frames that transmit no FAP are no animation (the FAP reader drops
+    // them), so a capture none of whose columns moves the face is refused.
+    if (c.mask.none())
+        t.fail(t.header_line, "a column that moves the face (an AU, shape, pose or gaze column the tables know)",
+               "none");
     fap::FapStream s;
     s.name = stream_name(source);
     double fps = kMediaPipeFrameFps;

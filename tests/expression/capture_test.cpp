@@ -394,6 +394,10 @@ const std::vector<Bad>& bad_inputs() {
         {"BadTimecode",
          [] { return live_link_csv({{"10:00:61:00.000", {}, {}}}); },
          "capture: take.csv:2: expected a Timecode HH:MM:SS:FF or HH:MM:SS:FF.fff, found \"10:00:61:00.000\""},
+        {"NoColumnMovesTheFace",  // found by the fuzzer: frames without FAPs did not survive a FAP round trip
+         [] { return std::string("frame, face_id, timestamp, confidence, success, AU03_r\n1, 0, 0.000, 0.98, 1, 1.0\n"); },
+         "capture: take.csv:1: expected a column that moves the face (an AU, shape, pose or gaze column the tables "
+         "know), found none"},
         {"NoFaceTracked",
          [] {
              OpenFaceRow a;
