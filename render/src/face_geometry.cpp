@@ -2,6 +2,7 @@
 
 #include "emoface/common/error.h"
 #include "emoface/common/parallel.h"
+#include "mesh_triangles.h"
 
 namespace emoface::render {
 namespace {
@@ -25,14 +26,7 @@ FaceGeometry::FaceGeometry(const expression::FaceRig& rig, const expression::Tri
     const int n = int(mesh.n_vertices());
     if (rig.vertex_count() != n)
         fail<InputError>("render: FaceGeometry: expected a mesh of the rig's {} vertices, found {}", rig.vertex_count(), n);
-    for (const auto fh : mesh.faces()) {
-        int idx[3], k = 0;
-        for (const auto vh : mesh.fv_range(fh)) {
-            if (k < 3) idx[k] = vh.idx();
-            ++k;
-        }
-        if (k == 3) triangles_.insert(triangles_.end(), idx, idx + 3);
-    }
+    triangles_ = triangle_indices(mesh);
     csr(n, int(triangles_.size()), [&](int c) { return triangles_[std::size_t(c)]; }, vertex_face_start_, vertex_faces_);
     for (int& c : vertex_faces_) c /= 3;  // corners to faces: each face once per vertex it has
 

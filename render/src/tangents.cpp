@@ -11,6 +11,7 @@
 #include "emoface/common/error.h"
 #include "emoface/common/parallel.h"
 #include "emoface/render/geometry_kernel.h"
+#include "mesh_triangles.h"
 
 namespace emoface::render {
 namespace {
@@ -34,16 +35,7 @@ void TangentFrames::compute(const expression::TriMesh& mesh) {
 
 void TangentFrames::build_topology(const expression::TriMesh& mesh) {
     const std::size_t n = mesh.n_vertices();
-    triangles_.clear();
-    triangles_.reserve(mesh.n_faces() * 3);
-    for (const auto fh : mesh.faces()) {
-        int idx[3], k = 0;
-        for (const auto vh : mesh.fv_range(fh)) {
-            if (k < 3) idx[k] = vh.idx();
-            ++k;
-        }
-        if (k == 3) triangles_.insert(triangles_.end(), idx, idx + 3);
-    }
+    triangles_ = triangle_indices(mesh);
     corner_start_.assign(n + 1, 0);
     for (const int v : triangles_) ++corner_start_[std::size_t(v) + 1];
     for (std::size_t v = 0; v < n; ++v) corner_start_[v + 1] += corner_start_[v];
