@@ -167,6 +167,11 @@ int main(int argc, char** argv) {
                     frames_name == "shader"       ? "vertex shader (closed form)"
                     : scene.uses_gpu_geometry() ? "GPU (CUDA into the vertex buffers)"
                                                 : "CPU (TangentFrames), uploaded");
+        if (scene.uses_gpu_geometry()) {
+            const render::CudaGeometry probe(*scene.geometry());
+            std::printf("  GPU geometry: %d part vertices, %d of them (fans' poles) with a warp each\n",
+                        scene.geometry()->view().part_vertices, probe.split_vertices());
+        }
         std::printf("  face: %zu vertices, %zu triangles; frame %dx%d, %d samples; FAP %s, %zu frames at %g fps\n",
                     face.mesh.n_vertices(), face.mesh.n_faces(), width, height, platform.samples(),
                     fap_path.c_str(), stream.frames.size(), stream.fps);
@@ -326,6 +331,32 @@ int main(int argc, char** argv) {
         }
         glDeleteQueries(1, &query);
 
+        // Pass 2b (CUDA morph and geometry): update() as pass 1 runs it, the
+        // morph and the geometry on their two streams between one mapping of
+        // the texture and the vertex buffers and one unmapping, timed by CUDA
+        // events on the morph's stream (which the unmapping waits on).
+        Series update_gpu_s;
+#if EMOFACE_BENCH_CUDA
+        if (cuda && geometry_stream) {
+            const auto s = static_cast<cudaStream_t>(scene.morpher().cuda_stream());
+            for (long i = 0; i < warmup + frames; ++i) {
+                const expression::FaceState state = state_of(frame_at(i));
+                const std::vector<float> w = render::key_weights(assets->keys, state);
+                cudaEventRecord(ev0, s);
+                scene.update(state.faps, w);
+                cudaEventRecord(ev1, s);
+                cudaEventSynchronize(ev1);
+                float e = 0;
+                cudaEventElapsedTime(&e, ev0, ev1);
+                platform.begin_frame();
+                scene.draw(draw);
+                platform.end_frame();
+                fence();
+                if (i >= warmup) update_gpu_s.add(e);
+            }
+        }
+#endif
+
         // Pass 3 (GPU geometry): the kernels alone, into device memory of
         // their own (no interop), the rig alone and rig + parts, CUDA events
         // around each launch pair.
@@ -394,6 +425,7 @@ int main(int argc, char** argv) {
         row("GPU: morph (map + kernel + unmap)", morph_s.median(), morph_s.pct(0.9));
         row("GPU: compute (geometry + morph, medians)", geometry_gpu_s.median() + morph_s.median(),
             geometry_gpu_s.pct(0.9) + morph_s.pct(0.9));
+        row("GPU: compute as update() runs it (one mapping)", update_gpu_s.median(), update_gpu_s.pct(0.9));
         row("draw (GL time, + MSAA resolve)", draw_s.median(), draw_s.pct(0.9));
         row("whole frame (sample .. fence)", whole.median(), whole.pct(0.9));
         std::printf("  whole frame - draw: %.3f ms (medians)\n", whole.median() - draw_s.median());

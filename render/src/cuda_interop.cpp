@@ -40,12 +40,16 @@ void WrinkleTexture::register_cuda() {
     cuda_resource_ = resource;
 }
 
-unsigned long long WrinkleTexture::map_surface(void* stream) {
+unsigned long long WrinkleTexture::map_surface(void* stream) { return map_surface(stream, {}); }
+
+unsigned long long WrinkleTexture::map_surface(void* stream, const std::vector<void*>& others) {
     if (surface_) fail("render: WrinkleTexture::map_surface(): already mapped");
     register_cuda();
     auto* resource = static_cast<cudaGraphicsResource_t>(cuda_resource_);
+    std::vector<cudaGraphicsResource_t> all{resource};
+    for (void* r : others) all.push_back(static_cast<cudaGraphicsResource_t>(r));
     auto s = static_cast<cudaStream_t>(stream);
-    check_cuda(cudaGraphicsMapResources(1, &resource, s), "cudaGraphicsMapResources");
+    check_cuda(cudaGraphicsMapResources(int(all.size()), all.data(), s), "cudaGraphicsMapResources");
     cudaArray_t array = nullptr;
     // The array may differ from one mapping to the next (CUDA's documentation),
     // so the surface object is made per mapping; it costs a few microseconds.
@@ -58,19 +62,22 @@ unsigned long long WrinkleTexture::map_surface(void* stream) {
         e = cudaCreateSurfaceObject(&surface, &desc);
     }
     if (e != cudaSuccess) {
-        cudaGraphicsUnmapResources(1, &resource, s);
+        cudaGraphicsUnmapResources(int(all.size()), all.data(), s);
         check_cuda(e, "getting a surface for the mapped texture");
     }
     surface_ = surface;
     return surface_;
 }
 
-void WrinkleTexture::unmap(void* stream) {
+void WrinkleTexture::unmap(void* stream) { unmap(stream, {}); }
+
+void WrinkleTexture::unmap(void* stream, const std::vector<void*>& others) {
     if (!surface_) return;
-    auto* resource = static_cast<cudaGraphicsResource_t>(cuda_resource_);
+    std::vector<cudaGraphicsResource_t> all{static_cast<cudaGraphicsResource_t>(cuda_resource_)};
+    for (void* r : others) all.push_back(static_cast<cudaGraphicsResource_t>(r));
     cudaDestroySurfaceObject(static_cast<cudaSurfaceObject_t>(surface_));
     surface_ = 0;
-    check_cuda(cudaGraphicsUnmapResources(1, &resource, static_cast<cudaStream_t>(stream)),
+    check_cuda(cudaGraphicsUnmapResources(int(all.size()), all.data(), static_cast<cudaStream_t>(stream)),
                "cudaGraphicsUnmapResources");
 }
 
@@ -120,12 +127,16 @@ std::vector<float*> GlBufferInterop::map(void* stream) {
     const auto s = static_cast<cudaStream_t>(stream);
     check_cuda(cudaGraphicsMapResources(int(resources_.size()), resources, s), "cudaGraphicsMapResources (buffers)");
     mapped_ = true;
+    return pointers();
+}
+
+std::vector<float*> GlBufferInterop::pointers() const {
     std::vector<float*> out;
     for (auto* r : resources_) {
         void* p = nullptr;
         std::size_t size = 0;
         check_cuda(cudaGraphicsResourceGetMappedPointer(&p, &size, static_cast<cudaGraphicsResource_t>(r)),
-                   "cudaGraphicsResourceGetMappedPointer");
+                   "cudaGraphicsResourceGetMappedPointer (are the buffers mapped?)");
         out.push_back(static_cast<float*>(p));
     }
     return out;

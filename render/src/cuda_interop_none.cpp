@@ -18,6 +18,13 @@ unsigned long long WrinkleTexture::map_surface(void*) {
 
 void WrinkleTexture::unmap(void*) {}
 
+unsigned long long WrinkleTexture::map_surface(void*, const std::vector<void*>&) {
+    register_cuda();
+    return 0;
+}
+
+void WrinkleTexture::unmap(void*, const std::vector<void*>&) {}
+
 void WrinkleTexture::unregister_cuda() noexcept {}
 
 }  // namespace emoface::render
@@ -32,5 +39,6 @@ GlBufferInterop::GlBufferInterop(const std::vector<unsigned>&) {
 GlBufferInterop::~GlBufferInterop() = default;
 std::vector<float*> GlBufferInterop::map(void*) { return {}; }
 void GlBufferInterop::unmap(void*) {}
+std::vector<float*> GlBufferInterop::pointers() const { return {}; }
 
 }  // namespace emoface::render

@@ -1,8 +1,8 @@
 // CudaGeometry: FaceGeometry's kernel bodies on the GPU. Three launches per
 // frame on its own stream: the rig over the full mesh into a device scratch
 // of positions, one thread per face (normal) and per part triangle (frame),
-// then one thread per part vertex for its normal, wrinkle UV and tangent
-// frame, gathered from those, written where the caller says (the mapped GL
+// then one thread per part vertex (a warp for a fan's pole) for its normal,
+// wrinkle UV and tangent frame, gathered from those, written where the caller says (the mapped GL
 // vertex buffers). The frame's parameters travel as the first launch's
 // argument: no copy, no wait.
 #include <cuda_runtime.h>
@@ -53,11 +53,52 @@ __global__ void face_kernel_launch(geometry_kernel::GeometryView g, const float*
     else if (i < faces + part_triangles) triangle_frames[i - faces] = geometry_kernel::part_triangle_pass(g, pos, i - faces);
 }
 
+// The warp's 32 shares of a gather added (butterfly: every lane ends with
+// the same sum, as a + b == b + a in floating point).
+__device__ geometry_kernel::V3 warp_sum(geometry_kernel::V3 v) {
+    for (int m = 16; m > 0; m >>= 1) {
+        v.x += __shfl_xor_sync(0xffffffffu, v.x, m);
+        v.y += __shfl_xor_sync(0xffffffffu, v.y, m);
+        v.z += __shfl_xor_sync(0xffffffffu, v.z, m);
+    }
+    return v;
+}
+
+__device__ geometry_kernel::TangentSum warp_sum(geometry_kernel::TangentSum s) {
+    s.t = warp_sum(s.t);
+    s.b = warp_sum(s.b);
+    for (int m = 16; m > 0; m >>= 1) s.w += __shfl_xor_sync(0xffffffffu, s.w, m);
+    return s;
+}
+
+// The per-part-vertex pass. Its first `split_blocks` blocks give each of the
+// `split` vertices with the longest gathers (at least kSplitGather: the
+// fans' poles) a warp, each lane a 32nd of the gathers; they come first so
+// that they start first. The blocks after have a thread per part vertex and
+// skip those.
+constexpr int kSplitGather = 24;
+constexpr int kBlock = 256;
+
 __global__ void part_kernel_launch(geometry_kernel::GeometryView g, const float* pos,
                                    const geometry_kernel::V3* face_normals,
-                                   const geometry_kernel::FaceFrame* triangle_frames, PartOutputs out) {
-    const int pv = blockIdx.x * blockDim.x + threadIdx.x;
-    if (pv >= g.part_vertices) return;
+                                   const geometry_kernel::FaceFrame* triangle_frames, PartOutputs out,
+                                   const int* split, int split_count, int split_blocks) {
+    if (int(blockIdx.x) < split_blocks) {
+        const int w = (blockIdx.x * blockDim.x + threadIdx.x) / 32, lane = threadIdx.x % 32;
+        if (w >= split_count) return;  // the whole warp
+        const int pv = split[w];
+        const int part = g.part_of[pv];
+        const int local = pv - g.part_first[part];
+        float* frame = g.part_frames[part] && out.frame[part] ? out.frame[part] + 6 * local : nullptr;
+        const geometry_kernel::V3 n =
+            geometry_kernel::unit_normal(warp_sum(geometry_kernel::part_normal_gather(g, face_normals, pv, lane, 32)));
+        geometry_kernel::TangentSum t{};
+        if (frame) t = warp_sum(geometry_kernel::part_tangent_gather(g, triangle_frames, pv, n, lane, 32));
+        if (lane == 0) geometry_kernel::part_vertex_write(g, pos, pv, n, t, out.shape[part] + 6 * local, frame);
+        return;
+    }
+    const int pv = (blockIdx.x - split_blocks) * blockDim.x + threadIdx.x;
+    if (pv >= g.part_vertices || geometry_kernel::part_gather_size(g, pv) >= kSplitGather) return;
     const int part = g.part_of[pv];
     const int local = pv - g.part_first[part];
     float* frame = g.part_frames[part] && out.frame[part] ? out.frame[part] + 6 * local : nullptr;
@@ -102,8 +143,12 @@ struct CudaGeometry::Impl {
     geometry_kernel::V3* face_normals = nullptr;
     geometry_kernel::FaceFrame* triangle_frames = nullptr;
     int faces = 0, part_triangles = 0;
+    const int* split = nullptr;  // part vertices whose gathers a warp shares
+    int split_count = 0;
     cudaStream_t stream = nullptr;
+    cudaEvent_t event = nullptr;  // orders the stream with another
     ~Impl() {
+        if (event) cudaEventDestroy(event);
         if (positions) cudaFree(positions);
         if (face_normals) cudaFree(face_normals);
         if (triangle_frames) cudaFree(triangle_frames);
@@ -152,6 +197,11 @@ CudaGeometry::CudaGeometry(const FaceGeometry& fg) : impl_(std::make_unique<Impl
     m.geometry.part_frames = a.copy(g.part_frames, std::size_t(m.parts));
     m.geometry.fixed_uvs = a.copy(g.fixed_uvs, g.fixed_uvs ? 2 * pv : 0);
     m.part_frames.assign(g.part_frames, g.part_frames + m.parts);
+    std::vector<int> split;
+    for (int v = 0; v < g.part_vertices; ++v)
+        if (geometry_kernel::part_gather_size(g, v) >= kSplitGather) split.push_back(v);
+    m.split_count = int(split.size());
+    m.split = a.copy(split.data(), split.size());
     check(cudaMalloc(reinterpret_cast<void**>(&m.positions), 3 * n * sizeof(float)), "cudaMalloc positions");
     m.faces = int(tris / 3);
     m.part_triangles = g.corner_start[pv] / 3;
@@ -161,9 +211,22 @@ CudaGeometry::CudaGeometry(const FaceGeometry& fg) : impl_(std::make_unique<Impl
                      std::size_t(m.part_triangles + 1) * sizeof(geometry_kernel::FaceFrame)),
           "cudaMalloc triangle frames");
     check(cudaStreamCreateWithFlags(&m.stream, cudaStreamNonBlocking), "cudaStreamCreate");
+    check(cudaEventCreateWithFlags(&m.event, cudaEventDisableTiming), "cudaEventCreate");
 }
 
 void* CudaGeometry::stream() const { return impl_->stream; }
+
+int CudaGeometry::split_vertices() const { return impl_->split_count; }
+
+void CudaGeometry::wait_for(void* other) {
+    check(cudaEventRecord(impl_->event, static_cast<cudaStream_t>(other)), "cudaEventRecord");
+    check(cudaStreamWaitEvent(impl_->stream, impl_->event, 0), "cudaStreamWaitEvent");
+}
+
+void CudaGeometry::join_into(void* other) {
+    check(cudaEventRecord(impl_->event, impl_->stream), "cudaEventRecord");
+    check(cudaStreamWaitEvent(static_cast<cudaStream_t>(other), impl_->event, 0), "cudaStreamWaitEvent");
+}
 
 void CudaGeometry::finish() { check(cudaStreamSynchronize(impl_->stream), "cudaStreamSynchronize"); }
 
@@ -184,7 +247,6 @@ void CudaGeometry::run(const expression::RigFrame& frame, const std::vector<floa
         out.frame[p] = frame_out[std::size_t(p)];
     }
     const cudaStream_t s = m.stream;
-    constexpr int kBlock = 256;
     const int n = m.rig.vertex_count, pv = m.geometry.part_vertices;
     rig_kernel_launch<<<(n + kBlock - 1) / kBlock, kBlock, 0, s>>>(m.rig, frame, m.positions);
     if (pv > 0) {
@@ -192,8 +254,9 @@ void CudaGeometry::run(const expression::RigFrame& frame, const std::vector<floa
         face_kernel_launch<<<(items + kBlock - 1) / kBlock, kBlock, 0, s>>>(m.geometry, m.positions, m.faces,
                                                                            m.part_triangles, m.face_normals,
                                                                            m.triangle_frames);
-        part_kernel_launch<<<(pv + kBlock - 1) / kBlock, kBlock, 0, s>>>(m.geometry, m.positions, m.face_normals,
-                                                                        m.triangle_frames, out);
+        const int split_blocks = (m.split_count * 32 + kBlock - 1) / kBlock;
+        part_kernel_launch<<<split_blocks + (pv + kBlock - 1) / kBlock, kBlock, 0, s>>>(
+            m.geometry, m.positions, m.face_normals, m.triangle_frames, out, m.split, m.split_count, split_blocks);
     }
     check(cudaGetLastError(), "launching the geometry kernels");
 }

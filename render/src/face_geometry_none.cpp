@@ -15,5 +15,8 @@ CudaGeometry::~CudaGeometry() = default;
 void CudaGeometry::run(const expression::RigFrame&, const std::vector<float*>&, const std::vector<float*>&) {}
 void* CudaGeometry::stream() const { return nullptr; }
 void CudaGeometry::finish() {}
+void CudaGeometry::wait_for(void*) {}
+void CudaGeometry::join_into(void*) {}
+int CudaGeometry::split_vertices() const { return 0; }
 
 }  // namespace emoface::render

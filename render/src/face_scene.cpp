@@ -321,9 +321,54 @@ void FaceScene::update(const expression::FapValues& faps, const std::vector<floa
         target_ = to_morph_layout(expression::layout_segments(lines_, layout_));
     }
     const double layout_ms = ms_since(t);
-    update_wrinkles(key_weights);
-    deform(faps, /*layout_from_mesh=*/false);
+    if (cuda_geometry_ && wrinkle_morph_->uses_interop()) {
+        update_on_gpu(faps, key_weights);
+    } else {
+        update_wrinkles(key_weights);
+        deform(faps, /*layout_from_mesh=*/false);
+    }
     times_.layout_ms = layout_ms;
+}
+
+void FaceScene::update_on_gpu(const expression::FapValues& faps, const std::vector<float>& key_weights) {
+    // The morph and the geometry, each on its own stream, between one
+    // mapping of the wrinkle texture and the vertex buffers together and one
+    // unmapping, both on the morph's stream (the geometry's waits for the
+    // mapping, the unmapping for the geometry): each mapping is a handoff
+    // between GL and CUDA that costs the GPU more than the geometry's kernels.
+    platform_.make_current();
+    auto t = Clock::now();
+    frame_ = rig_.frame(faps);
+    void* morph_stream = morpher_->cuda_stream();
+    const std::vector<void*>& buffers = geometry_buffers_->resources();
+    const unsigned long long surface = texture_->map_surface(morph_stream, buffers);
+    try {
+        cuda_geometry_->wait_for(morph_stream);
+        run_gpu_geometry(geometry_buffers_->pointers());
+        times_.rig_ms = ms_since(t);  // host time: parameters, map, launches
+        t = Clock::now();
+        morpher_->morph_to_surface(target_, key_weights, params_, surface);
+        cuda_geometry_->join_into(morph_stream);
+    } catch (...) {
+        try {
+            texture_->unmap(morph_stream, buffers);
+        } catch (...) {  // the first error is the one to report
+        }
+        throw;
+    }
+    texture_->unmap(morph_stream, buffers);
+    times_.morph_ms = ms_since(t);
+    times_.uv_ms = times_.tangents_ms = times_.upload_ms = 0.0;
+}
+
+void FaceScene::run_gpu_geometry(const std::vector<float*>& buffers) {
+    std::vector<float*> shape, frames;
+    std::size_t next = 0;
+    for (int p = 0; p < geometry_->part_count(); ++p) {
+        shape.push_back(buffers[next++]);
+        frames.push_back(geometry_->part(p).frames ? buffers[next++] : nullptr);
+    }
+    cuda_geometry_->run(frame_, shape, frames);
 }
 
 void FaceScene::update_wrinkles(const std::vector<float>& key_weights) {
@@ -342,20 +387,12 @@ void* FaceScene::geometry_stream() const { return cuda_geometry_ ? cuda_geometry
 void FaceScene::deform_on_gpu(const expression::FapValues& faps, bool layout_from_mesh) {
     const auto t = Clock::now();
     frame_ = rig_.frame(faps);
-    const expression::RigFrame& frame = frame_;
     if (layout_from_mesh && layout_kind_ == WrinkleLayout::Projective) {
-        layout_ = layout_of(rig_.feature_points(frame), present_points(face_), box_);
+        layout_ = layout_of(rig_.feature_points(frame_), present_points(face_), box_);
         target_ = to_morph_layout(expression::layout_segments(lines_, layout_));
     }
     void* stream = cuda_geometry_->stream();
-    const std::vector<float*> mapped = geometry_buffers_->map(stream);
-    std::vector<float*> shape, frames;
-    std::size_t next = 0;
-    for (int p = 0; p < geometry_->part_count(); ++p) {
-        shape.push_back(mapped[next++]);
-        frames.push_back(geometry_->part(p).frames ? mapped[next++] : nullptr);
-    }
-    cuda_geometry_->run(frame, shape, frames);
+    run_gpu_geometry(geometry_buffers_->map(stream));
     geometry_buffers_->unmap(stream);
     times_.rig_ms = ms_since(t);  // host time: parameters, map, launches, unmap
     times_.uv_ms = times_.tangents_ms = times_.upload_ms = 0.0;

@@ -14,6 +14,7 @@
 
 #include "emoface/render/face_assets.h"
 #include "emoface/render/face_scene.h"
+#include "emoface/render/image_diff.h"
 #include "face_geometry_cases.h"
 
 namespace emoface::render {
@@ -110,6 +111,56 @@ TEST(FaceSceneGeometry, GpuByDefaultWithTheSurfaceOfTheCpuGeometry) {
         EXPECT_LE(worst_position, 1e-4f) << named.name;
         EXPECT_LE(worst_normal, 1e-3f) << named.name;
         if (named.name != "neutral") EXPECT_GT(moved, 1e-3f) << named.name << ": the feature points did not move";
+    }
+}
+
+// update() on a CUDA scene maps the wrinkle texture and the vertex buffers
+// in one call and runs the morph and the geometry on two streams in between;
+// what it draws is what the CPU morph and geometry draw, frame after frame
+// (a wrong order between the streams and the mapping would draw stale or
+// half-written buffers).
+TEST(FaceSceneGeometry, OneMappingDrawsWhatTheCpuDraws) {
+    if (!cuda_geometry_available()) GTEST_SKIP() << "no CUDA device: the GPU geometry is not tested here";
+    FaceAssetsOptions ao;
+    ao.face.resolution_scale = 0.5;
+    ao.face.texture_size = 256;
+    ao.wrinkle_map_size = 256;
+    const auto assets = load_default_face_assets(EMOFACE_DATA_DIR, ao);
+    PlatformOptions po;
+    po.width = po.height = 160;
+    po.cuda_device = 0;
+    HeadlessPlatform platform(po);
+    FaceSceneOptions gpu_options;
+    gpu_options.backend = morph::Backend::Cuda;
+    const auto gpu = make_face_scene(platform, *assets, gpu_options);
+    if (!gpu->uses_interop()) GTEST_SKIP() << "the GL context is not on the CUDA device: no interop";
+    ASSERT_TRUE(gpu->uses_gpu_geometry());
+    FaceSceneOptions cpu_options;
+    cpu_options.backend = morph::Backend::Cpu;
+    const auto cpu = make_face_scene(platform, *assets, cpu_options);
+
+    DrawOptions draw;
+    draw.camera = cpu->frontal_camera(1.0f);
+    draw.light = cpu->portrait_light();
+    draw.shading = Shading::Thesis;
+    auto render = [&](FaceScene& scene) {
+        platform.begin_frame();
+        scene.draw(draw);
+        platform.end_frame();
+        return platform.read_rgba();
+    };
+    // Every key at once, so the morph writes wrinkles everywhere it can.
+    const std::vector<float> weights(std::size_t(gpu->key_count()), 1.0f / float(gpu->key_count()));
+    ImageRGBA8 previous;
+    for (const NamedFaps& named : frames()) {
+        gpu->update(named.faps, weights);
+        const ImageRGBA8 g = render(*gpu);
+        cpu->update(named.faps, weights);
+        const ImageRGBA8 c = render(*cpu);
+        EXPECT_GE(diff_images(g, c).psnr(), 40.0) << named.name;
+        if (!previous.pixels.empty() && named.name != "neutral")
+            EXPECT_LT(diff_images(g, previous).psnr(), 60.0) << named.name << ": the frame did not change";
+        previous = g;
     }
 }
 

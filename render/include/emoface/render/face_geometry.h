@@ -85,6 +85,14 @@ public:
     void run(const expression::RigFrame& frame, const std::vector<float*>& shape, const std::vector<float*>& frame_out);
     void* stream() const;  // a cudaStream_t
     void finish();         // waits for the stream
+    // Orders this object's stream and another (a cudaStream_t): work queued
+    // here after wait_for() waits for what `other` has queued so far; work
+    // queued on `other` after join_into() waits for what is queued here.
+    void wait_for(void* other);
+    void join_into(void* other);
+    // How many part vertices have gathers long enough (a fan's pole) that a
+    // warp shares each: the pass would otherwise last as long as their one thread.
+    int split_vertices() const;
 
 private:
     struct Impl;
@@ -101,6 +109,11 @@ public:
     // All buffers mapped in one call; their device pointers, in order.
     std::vector<float*> map(void* stream);
     void unmap(void* stream);
+    // The registered buffers (cudaGraphicsResource_t), for a mapping together
+    // with other resources (WrinkleTexture::map_surface(stream, others)), and
+    // their device pointers while so mapped.
+    const std::vector<void*>& resources() const { return resources_; }
+    std::vector<float*> pointers() const;
 
 private:
     std::vector<void*> resources_;

@@ -196,6 +196,10 @@ private:
     // points when asked (projective layout; the anchored L* never moves).
     void deform(const expression::FapValues& faps, bool layout_from_mesh);
     void deform_on_gpu(const expression::FapValues& faps, bool layout_from_mesh);
+    // update() with the morph and the geometry both on CUDA: one mapping for both.
+    void update_on_gpu(const expression::FapValues& faps, const std::vector<float>& key_weights);
+    // CudaGeometry::run into the mapped vertex buffers (GlBufferInterop's order).
+    void run_gpu_geometry(const std::vector<float*>& buffers);
 
     Platform& platform_;
     const expression::Face& face_;

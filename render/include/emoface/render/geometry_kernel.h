@@ -10,9 +10,9 @@
 #include "emoface/common/hd.h"
 
 // A vertex's gathers loop over its faces; a fan's pole has hundreds (274 on
-// the default head), and on the GPU its one thread sets the pass's time.
-// Unrolled, the loads of several faces are in flight at once (H100: the
-// geometry kernels 0.176 -> 0.169 ms).
+// the default head). On the GPU such a vertex's gathers are shared by a
+// warp (face_geometry.cu); unrolled, a thread has the loads of several
+// faces in flight at once.
 #if defined(__CUDA_ARCH__)
 #define EMOFACE_GATHER_UNROLL _Pragma("unroll 8")
 #else
@@ -126,19 +126,30 @@ EMOFACE_HD EMOFACE_INLINE FaceFrame face_frame(const V3 p[3], const V2 uv[3]) {
     return f;
 }
 
-// The tangent frame of a vertex with normal `nv` (any length) from its
-// corners: corner(k, t, b, angle) gives the k-th corner's face t and b and
-// the corner's angle, for k < count. w holds the handedness; *fallback says
-// whether the vertex had no usable direction of its own.
+// A vertex's tangent gather, summed over its corners k = lane, lane +
+// lanes, ... below count (lanes > 1: one share of a gather split over
+// several threads, the shares added after; lanes = 1: the whole gather).
+struct TangentSum {
+    V3 t, b;  // handedness-signed tangents and bitangents, angle-weighted
+    float w;  // angle-weighted handedness
+};
+
+EMOFACE_HD EMOFACE_INLINE TangentSum operator+(TangentSum a, TangentSum b) { return {a.t + b.t, a.b + b.b, a.w + b.w}; }
+
+// The unit normal a frame is built around, from the vertex normal `nv`
+// (any length); *has_normal false where it has none.
+EMOFACE_HD EMOFACE_INLINE V3 frame_normal(V3 nv, bool* has_normal) {
+    *has_normal = usable(nv, kMinLength2);
+    return *has_normal ? nv / sqrtf(dot(nv, nv)) : V3{0, 0, 1};
+}
+
+// corner(k, t, b, angle) gives the k-th corner's face t and b and the
+// corner's angle, for k < count; nn from frame_normal().
 template <class Corner>
-EMOFACE_HD EMOFACE_INLINE V4 vertex_tangent(V3 nv, int count, const Corner& corner, bool* fallback) {
-    const bool has_normal = usable(nv, kMinLength2);
-    const V3 nn = has_normal ? nv / sqrtf(dot(nv, nv)) : V3{0, 0, 1};
-    V3 t_sum{0, 0, 0}, b_sum{0, 0, 0};
-    float w_sum = 0.0f;
-    if (!has_normal) count = 0;
+EMOFACE_HD EMOFACE_INLINE TangentSum tangent_gather(V3 nn, int count, const Corner& corner, int lane, int lanes) {
+    TangentSum s{{0, 0, 0}, {0, 0, 0}, 0.0f};
     EMOFACE_GATHER_UNROLL
-    for (int k = 0; k < count; ++k) {
+    for (int k = lane; k < count; k += lanes) {
         V3 ft, fb;
         float angle;
         corner(k, ft, fb, angle);
@@ -151,22 +162,37 @@ EMOFACE_HD EMOFACE_INLINE V4 vertex_tangent(V3 nv, int count, const Corner& corn
         // the tangents of mirrored halves (u runs the other way) from
         // cancelling where they meet; the vertex then takes the dominant w.
         const float w = dot(cross(nn, t), bt) < 0 ? -1.0f : 1.0f;
-        t_sum = t_sum + (angle * w) * t;
-        b_sum = b_sum + angle * bt;
-        w_sum += angle * w;
+        s.t = s.t + (angle * w) * t;
+        s.b = s.b + angle * bt;
+        s.w += angle * w;
     }
-    const float w = w_sum < 0 ? -1.0f : 1.0f;
-    V3 t = reject(t_sum, nn);
+    return s;
+}
+
+// The tangent (xyz, handedness w) from a vertex's whole gather; *fallback
+// says whether the vertex had no usable direction of its own.
+EMOFACE_HD EMOFACE_INLINE V4 tangent_finish(V3 nn, const TangentSum& s, bool* fallback) {
+    const float w = s.w < 0 ? -1.0f : 1.0f;
+    V3 t = reject(s.t, nn);
     *fallback = false;
     if (usable(t, kMinLength2)) {
         t = w * normalize(t);
     } else {
         *fallback = true;
-        const V3 b = reject(b_sum, nn);
+        const V3 b = reject(s.b, nn);
         // B = w cross(N, T) for an orthonormal frame, hence T = w cross(B, N).
         t = usable(b, kMinLength2) ? w * normalize(cross(b, nn)) : any_perpendicular(nn);
     }
     return {t.x, t.y, t.z, usable(t, kMinLength2) ? w : 1.0f};
+}
+
+// The tangent frame of a vertex with normal `nv` (any length) from its
+// `count` corners (tangent_gather's corner), in one thread.
+template <class Corner>
+EMOFACE_HD EMOFACE_INLINE V4 vertex_tangent(V3 nv, int count, const Corner& corner, bool* fallback) {
+    bool has_normal = false;
+    const V3 nn = frame_normal(nv, &has_normal);
+    return tangent_finish(nn, tangent_gather(nn, has_normal ? count : 0, corner, 0, 1), fallback);
 }
 
 // Flat arrays of the topology, host or device pointers alike (one layout
@@ -216,19 +242,26 @@ EMOFACE_HD EMOFACE_INLINE FaceFrame part_triangle_pass(const GeometryView& g, co
     return face_frame(p, uv);
 }
 
-// Part vertex pv: position and normal into shape[0..5]; when `frame` is
-// set (a part with frames), tangent xyzw and wrinkle UV into frame[0..5].
-EMOFACE_HD EMOFACE_INLINE void part_vertex_pass(const GeometryView& g, const float* pos, const V3* face_normals,
-                                                const FaceFrame* triangle_frames, int pv, float* shape, float* frame) {
+// Part vertex pv's two gathers, each summed over its share k = lane, lane +
+// lanes, ... (on the GPU a vertex of hundreds of faces, a fan's pole, is
+// split over a warp; every other vertex, and the CPU, take lanes = 1).
+// First its full-mesh faces' normals,
+EMOFACE_HD EMOFACE_INLINE V3 part_normal_gather(const GeometryView& g, const V3* face_normals, int pv, int lane,
+                                                int lanes) {
     const int v = g.part_full[pv];
-    const V3 p = at(pos, v);
     V3 sum{0, 0, 0};
     EMOFACE_GATHER_UNROLL
-    for (int k = g.vertex_face_start[v]; k < g.vertex_face_start[v + 1]; ++k) sum = sum + face_normals[g.vertex_faces[k]];
-    const V3 n = unit_normal(sum);
-    shape[0] = p.x, shape[1] = p.y, shape[2] = p.z;
-    shape[3] = n.x, shape[4] = n.y, shape[5] = n.z;
-    if (!frame) return;
+    for (int k = g.vertex_face_start[v] + lane; k < g.vertex_face_start[v + 1]; k += lanes)
+        sum = sum + face_normals[g.vertex_faces[k]];
+    return sum;
+}
+
+// then, around n (unit_normal of the whole first gather), its part
+// triangles' frames.
+EMOFACE_HD EMOFACE_INLINE TangentSum part_tangent_gather(const GeometryView& g, const FaceFrame* triangle_frames,
+                                                         int pv, V3 n, int lane, int lanes) {
+    bool has_normal = false;
+    const V3 nn = frame_normal(n, &has_normal);
     const int first = g.corner_start[pv];
     auto corner = [&](int k, V3& t, V3& b, float& angle) {
         const int c = g.corners[first + k];
@@ -237,11 +270,40 @@ EMOFACE_HD EMOFACE_INLINE void part_vertex_pass(const GeometryView& g, const flo
         b = f.b;
         angle = f.angle[c % 3];
     };
-    bool fallback = false;
-    const V4 tangent = vertex_tangent(n, g.corner_start[pv + 1] - first, corner, &fallback);
+    return tangent_gather(nn, has_normal ? g.corner_start[pv + 1] - first : 0, corner, lane, lanes);
+}
+
+// The longer of part vertex pv's two gathers (what a thread's time grows with).
+EMOFACE_HD EMOFACE_INLINE int part_gather_size(const GeometryView& g, int pv) {
+    const int v = g.part_full[pv];
+    const int faces = g.vertex_face_start[v + 1] - g.vertex_face_start[v];
+    const int corners = g.corner_start[pv + 1] - g.corner_start[pv];
+    return faces > corners ? faces : corners;
+}
+
+// Part vertex pv from its whole gathers (n: the unit normal; tangent_sum:
+// the tangent gather around it): position and normal into shape[0..5];
+// when `frame` is set (a part with frames), tangent xyzw and wrinkle UV
+// into frame[0..5].
+EMOFACE_HD EMOFACE_INLINE void part_vertex_write(const GeometryView& g, const float* pos, int pv, V3 n,
+                                                 const TangentSum& tangent_sum, float* shape, float* frame) {
+    const V3 p = at(pos, g.part_full[pv]);
+    shape[0] = p.x, shape[1] = p.y, shape[2] = p.z;
+    shape[3] = n.x, shape[4] = n.y, shape[5] = n.z;
+    if (!frame) return;
+    bool has_normal = false, fallback = false;
+    const V4 tangent = tangent_finish(frame_normal(n, &has_normal), tangent_sum, &fallback);
     const V2 uv = wrinkle_uv(g, pos, pv);
     frame[0] = tangent.x, frame[1] = tangent.y, frame[2] = tangent.z, frame[3] = tangent.w;
     frame[4] = uv.x, frame[5] = uv.y;
+}
+
+// Part vertex pv in one thread.
+EMOFACE_HD EMOFACE_INLINE void part_vertex_pass(const GeometryView& g, const float* pos, const V3* face_normals,
+                                                const FaceFrame* triangle_frames, int pv, float* shape, float* frame) {
+    const V3 n = unit_normal(part_normal_gather(g, face_normals, pv, 0, 1));
+    const TangentSum t = frame ? part_tangent_gather(g, triangle_frames, pv, n, 0, 1) : TangentSum{};
+    part_vertex_write(g, pos, pv, n, t, shape, frame);
 }
 
 }  // namespace emoface::render::geometry_kernel

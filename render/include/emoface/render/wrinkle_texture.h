@@ -12,6 +12,7 @@
 // (y + 0.5) / H): v runs down the image. The tangent-space normal's x goes
 // along +u (image right) and y along +v (image down), z out of the skin.
 #include <cstddef>
+#include <vector>
 
 #include "emoface/render/renderer.h"
 
@@ -58,6 +59,12 @@ public:
     // until unmap().
     unsigned long long map_surface(void* stream = nullptr);
     void unmap(void* stream = nullptr);
+    // The same with `others` (other registered cudaGraphicsResource_t: a
+    // GlBufferInterop's) mapped and unmapped in the same calls: each mapping
+    // is a handoff between GL and CUDA that costs more GPU time than a
+    // small kernel, so a frame makes one for all its resources.
+    unsigned long long map_surface(void* stream, const std::vector<void*>& others);
+    void unmap(void* stream, const std::vector<void*>& others);
     bool mapped() const { return surface_ != 0; }
 
 private:
