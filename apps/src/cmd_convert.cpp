@@ -58,9 +58,14 @@ void convert(const ConvertArgs& a) {
 
     std::string text;
     const char* written = "";
+    std::string note;
     if (to == "fap") {
-        text = emoface::fap::format_fap(in.stream);
+        // What Xface's reader takes (fap_io.h, for_xface); emoface reads it too.
+        const emoface::fap::FapStream xface = emoface::fap::for_xface(in.stream);
+        text = emoface::fap::format_fap(xface);
         written = "FAP";
+        if (xface.fps != in.stream.fps)
+            note = fmt::format(", resampled at {:g} fps: Xface reads whole frame rates", xface.fps);
     } else {
         const auto emotions = ex::load_emotion_profiles(a.data + "/expression/emotions.json");
         const auto visemes = ex::load_viseme_profiles(a.data + "/expression/visemes.json");
@@ -76,8 +81,8 @@ void convert(const ConvertArgs& a) {
     }
     emoface::write_file_atomically(out.path(), text, "convert");
     out.commit();
-    fmt::print("{} ({}, {} frames at {:g} fps) -> {} ({})\n", a.in, ex::animation_format_name(in.format),
-               in.stream.frames.size(), in.stream.fps, a.out, written);
+    fmt::print("{} ({}, {} frames at {:g} fps) -> {} ({}{})\n", a.in, ex::animation_format_name(in.format),
+               in.stream.frames.size(), in.stream.fps, a.out, written, note);
 }
 
 void add_convert_command(CLI::App& root) {
@@ -85,8 +90,9 @@ void add_convert_command(CLI::App& root) {
     auto* sub = root.add_subcommand(
         "convert",
         "Convert an animation file (FAP, OpenFace 2.0 CSV, Live Link Face or MediaPipe blendshape CSV; told from "
-        "its content) to a FAP file, a Live Link Face ARKit CSV or an OpenFace-style AU CSV");
-    sub->add_option("in", a->in, "Animation file to read")->required();
+        "its content) to a FAP file Xface reads (whole fps, frames from 0, integer values), a Live Link Face "
+        "ARKit CSV or an OpenFace-style AU CSV");
+    sub->add_option("in", a->in, "Animation file to read: FAP, or an OpenFace, Live Link Face or MediaPipe CSV")->required();
     sub->add_option("out", a->out, "File to write (.fap, or .csv with --to)")->required();
     sub->add_option("--to", a->to, "fap, arkit (Live Link Face CSV) or openface (AU CSV); default: from OUT's .fap");
     sub->add_option("--data", a->data, "The project's data folder (AU, ARKit, emotion and viseme tables)")

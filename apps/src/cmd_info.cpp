@@ -117,7 +117,8 @@ void print_text(const std::string& path, const FapStream& s) {
         fmt::print("  moving    {}{}\n", fmt::join(movers, ", "),
                    sum.moving.empty() ? "; no low-level FAP" : "");
     for (const FapRange& r : sum.moving)
-        fmt::print("    {:>2} {:<22} {} .. {}\n", r.fap, fap_info(r.fap).name, r.min, r.max);
+        // 176, not 176.00000000000003 (a capture's interpolation); 0, not -0.
+        fmt::print("    {:>2} {:<22} {:g} .. {:g}\n", r.fap, fap_info(r.fap).name, r.min + 0.0, r.max + 0.0);
     auto span = [](const CodeUse& u) {
         return fmt::format("{} {} in {}..{}", u.frames, frames_word(u.frames), u.first, u.last);
     };
@@ -215,14 +216,16 @@ nlohmann::json to_json(const std::string& path, const FapStream& s) {
 
 void add_info_command(CLI::App& root) {
     auto* sub = root.add_subcommand(
-        "info", "Summarise animation files (FAP, OpenFace, Live Link Face or MediaPipe CSV): version, name, fps, frames, duration, moving FAPs, FAP 1/2 use, warnings");
+        "info",
+        "Summarise animation files (FAP, OpenFace 2.0, Live Link Face or MediaPipe CSV): version, name, fps, "
+        "frames, duration, moving FAPs, FAP 1/2 use, action units, warnings");
     auto files = std::make_shared<std::vector<std::string>>();
     auto json = std::make_shared<bool>(false);
-    sub->add_option("files", *files, "Animation files: FAP or capture CSV")->required();
+    sub->add_option("files", *files, "Animation files: FAP, or OpenFace, Live Link Face or MediaPipe CSV (told from the content)")->required();
     sub->add_flag("--json", *json, "Print a JSON array, one object per file");
     auto data = std::make_shared<std::string>(EMOFACE_DATA_DIR);
     auto frame = std::make_shared<int>(-1);
-    sub->add_option("--data", *data, "The project's data folder (for the action units)")->capture_default_str();
+    sub->add_option("--data", *data, "The project's data folder (the AU and ARKit tables)")->capture_default_str();
     sub->add_option("--frame", *frame, "Show this frame's action units (index from 0) instead of their peaks")
         ->check(CLI::NonNegativeNumber);
     sub->callback([files, json, data, frame] {

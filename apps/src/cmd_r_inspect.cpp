@@ -89,7 +89,7 @@ void run_inspect(const InspectArgs& a) {
     std::optional<fap::FapStream> stream;
     expression::EmotionMix mix;
     if (!a.fap.empty()) {
-        stream = fap::resolve_untransmitted(load_fap_stream(a.fap));
+        stream = fap::resolve_untransmitted(load_fap_stream(a.fap, a.session.options.data));
         if (a.frame < 0 || std::size_t(a.frame) >= stream->frames.size())
             fail<InputError>("inspect: --frame {}: {} has frames 0..{}", a.frame, a.fap, stream->frames.size() - 1);
     } else {
@@ -183,9 +183,11 @@ void add_inspect_command(CLI::App& root) {
         "The 84 feature points (labelled) and the morph's feature lines over the render and the "
         "wrinkle map, side by side; without --out, a window stepping through the frames");
     auto a = std::make_shared<InspectArgs>();
-    sub->add_option("file", a->fap, "FAP file (optional; else --mix, else neutral)");
-    sub->add_option("--frame", a->frame, "Frame of the FAP file (0-based)")->capture_default_str();
-    sub->add_option("--mix", a->mix, "Emotion mix instead of a FAP file, e.g. \"0.7 anger + 0.3 fear\"");
+    sub->add_option("file", a->fap,
+                    "Animation file: FAP, or an OpenFace, Live Link Face or MediaPipe CSV (optional; else --mix, "
+                    "else neutral)");
+    sub->add_option("--frame", a->frame, "Frame of the animation file (0-based)")->capture_default_str();
+    sub->add_option("--mix", a->mix, "Emotion mix instead of an animation file, e.g. \"0.7 anger + 0.3 fear\"");
     sub->add_flag("--normalise", a->normalise, "Scale a mix summing over 1 down to 1");
     CLI::Option* out = sub->add_option("-o,--out", a->out, "Output picture (.png, ...); without it: a window");
     sub->add_option("--size", a->size, "Render size WIDTHxHEIGHT (the map is shown HEIGHT square)")

@@ -138,7 +138,7 @@ std::string file_name(const std::string& path) { return std::filesystem::path(pa
 
 void run_play(const PlayArgs& a) {
     // Bad input fails before anything slow happens or is written.
-    const fap::FapStream stream = load_fap_stream(a.fap);
+    const fap::FapStream stream = load_fap_stream(a.fap, a.session.options.data);
     if (a.fps_given)
         check_in_range("play", "--fps", a.fps, render::kMinVideoFps, render::kMaxVideoFps, " frames per second");
     if (a.crf_given) check_in_range("play", "--crf", a.crf, 0, 63, " (H.264 0..51, VP9 0..63)");
@@ -245,10 +245,13 @@ void run_play(const PlayArgs& a) {
 void add_play_command(CLI::App& root) {
     auto* sub = root.add_subcommand(
         "play",
-        "Play a FAP file on a face: headless into a video or frame sequence with --out, else in "
-        "the viewer");
+        "Play an animation file (FAP, or an OpenFace, Live Link Face or MediaPipe CSV) on a face: headless "
+        "into a video or frame sequence with --out, else in the viewer");
     auto a = std::make_shared<PlayArgs>();
-    sub->add_option("file", a->fap, "MPEG-4 FAP file (.fap)")->required();
+    sub->add_option("file", a->fap,
+                    "Animation file: MPEG-4 FAP (.fap), OpenFace 2.0 CSV, Live Link Face (ARKit) CSV or MediaPipe "
+                    "blendshape CSV, told from its content")
+        ->required();
     CLI::Option* out = sub->add_option("-o,--out", a->out,
                     "Video (.mp4 or .mkv: H.264 + AAC; .webm: VP9 + Opus; .avi: Motion-JPEG + PCM) or "
                     "frame pattern (frames/%04d.png, numbered by frame). Without it: the viewer");

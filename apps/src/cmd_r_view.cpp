@@ -1,6 +1,6 @@
 // emoface view: the interactive viewer (viewer.h) in a window.
 //   emoface view                                  sliders for the six emotions
-//   emoface view anim.fap                         plays the file (timeline)
+//   emoface view anim.fap                         plays the file (timeline; a capture CSV too)
 //   emoface view --mix "0.7 anger + 0.3 fear" --wrinkles painted/
 //   emoface view anim.fap --quit-after 60 --screenshot shot.png
 #include <memory>
@@ -26,7 +26,8 @@ void add_view_command(CLI::App& root) {
         "Open the interactive viewer: orbit/zoom with the mouse, emotion sliders, FAP timeline,\n"
         "wrinkles, feature points and lines, CPU/GPU morph (needs a display)");
     auto args = std::make_shared<ViewArgs>();
-    sub->add_option("file", args->viewer.fap_path, "FAP file to play (optional)");
+    sub->add_option("file", args->viewer.fap_path,
+                    "Animation file to play (optional): FAP, or an OpenFace, Live Link Face or MediaPipe CSV");
     sub->add_option("--mix", args->viewer.mix, "Emotion mix the sliders start at, e.g. \"0.7 anger + 0.3 fear\"");
     sub->add_option("--size", args->size, "Window size WIDTHxHEIGHT")->capture_default_str();
     apps::add_session_options(*sub, args->session);

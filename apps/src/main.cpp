@@ -16,7 +16,7 @@ std::vector<CommandSetup>& registered_commands();
 int main(int argc, char** argv) {
     using namespace emoface::apps;
     CLI::App app{
-        "emoface: plays MPEG-4 facial animation (FAP files) and emotion mixtures\n"
+        "emoface: plays MPEG-4 facial animation (FAP files, or OpenFace and ARKit capture CSVs) and emotion mixtures\n"
         "on a face mesh, with wrinkle maps morphed every frame and bump-mapped.",
         // Named, so usage lines say `emoface play ...`, not argv[0]'s full path.
         "emoface"};

@@ -155,9 +155,11 @@ std::string format_times(const LoadTimes& load, const FrameTimeTotals& frames);
 
 
 // Reads an animation file of any known format for playing (a FAP file or a
-// capture CSV, expression/capture.h; `data` holds the AU and ARKit tables);
-// InputError when it has no frames or its frame rate is not positive.
-fap::FapStream load_fap_stream(const std::string& path, const std::string& data = EMOFACE_DATA_DIR);
+// capture CSV, expression/capture.h; `data` holds the AU and ARKit tables:
+// the command's --data, no default, so none reads the built-in tables behind
+// its user's back); InputError when it has no frames or its frame rate is not
+// positive.
+fap::FapStream load_fap_stream(const std::string& path, const std::string& data);
 
 // The morph accuracy a command takes when --morph-accuracy is not given:
 // fast for the commands that play frames in time (play, view; their

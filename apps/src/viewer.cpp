@@ -655,7 +655,7 @@ int run_viewer(const ViewerOptions& options) {
     if (options.quit_after_frames < 0)
         fail<InputError>("{}: --quit-after {}: expected a frame count >= 0", command, options.quit_after_frames);
     std::optional<fap::FapStream> stream;
-    if (!options.fap_path.empty()) stream = fap::resolve_untransmitted(load_fap_stream(options.fap_path));
+    if (!options.fap_path.empty()) stream = fap::resolve_untransmitted(load_fap_stream(options.fap_path, so.data));
     const expression::EmotionMix mix =
         options.mix.empty() ? expression::EmotionMix{} : expression::parse_emotion_mix(options.mix);
     std::error_code ec;  // a FIFO, a device, a link loop: the face readers say which

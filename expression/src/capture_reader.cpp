@@ -386,7 +386,8 @@ std::string list(const std::vector<std::string>& names) {
 }
 
 std::vector<Candidate> candidates(const CsvTable& t) {
-    Candidate of{AnimationFormat::OpenFace}, llf{AnimationFormat::LiveLinkFace}, mp{AnimationFormat::MediaPipe};
+    Candidate of{AnimationFormat::OpenFace, 0, {}}, llf{AnimationFormat::LiveLinkFace, 0, {}},
+        mp{AnimationFormat::MediaPipe, 0, {}};
     auto need = [&](Candidate& c, const std::string& name) {
         if (t.column(name) >= 0) ++c.found;
         else c.missing.push_back(name);

@@ -1,4 +1,6 @@
 // The ASCII FAP writer: writes exactly what fap_reader.cpp reads back.
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <string>
@@ -99,6 +101,76 @@ std::string format_fap(const FapStream& s) {
 void write_fap_file(const FapStream& stream, const std::string& path) {
     const std::string text = format_fap(stream);
     write_file_atomically(path, text, "fap");
+}
+
+namespace {
+
+constexpr std::size_t kXfaceNameBytes = 254;  // FAPFile::open reads the name into char[255]
+constexpr double kXfaceMaxFps = 32767;        // its frame rate is a short
+
+std::string xface_name(const std::string& name) {
+    std::string out;
+    for (char c : name) {
+        if (std::isspace(static_cast<unsigned char>(c))) {
+            if (!out.empty() && out.back() != '_') out += '_';
+        } else {
+            out += c;
+        }
+    }
+    while (!out.empty() && out.back() == '_') out.pop_back();
+    if (out.empty()) out = "emoface";
+    if (out.size() > kXfaceNameBytes) {
+        out.resize(kXfaceNameBytes);
+        // Not in the middle of a UTF-8 sequence.
+        while (!out.empty() && (static_cast<unsigned char>(out.back()) & 0xC0) == 0x80) out.pop_back();
+        if (!out.empty() && (static_cast<unsigned char>(out.back()) & 0x80)) out.pop_back();
+    }
+    return out;
+}
+
+// Resolved frames at `fps`, as FapStream::sample interpolates them (the
+// viseme and expression of the earlier frame).
+std::vector<FapFrame> resample_resolved(const std::vector<FapFrame>& frames, double from_fps, double fps) {
+    const double duration = static_cast<double>(frames.size()) / from_fps;
+    const auto count = static_cast<std::size_t>(std::max(1.0, std::round(duration * fps)));
+    std::vector<FapFrame> out(count);
+    for (std::size_t k = 0; k < count; ++k) {
+        const double position = static_cast<double>(k) / fps * from_fps;
+        const std::size_t a = std::min(static_cast<std::size_t>(position), frames.size() - 1);
+        const std::size_t b = std::min(a + 1, frames.size() - 1);
+        const double t = std::clamp(position - static_cast<double>(a), 0.0, 1.0);
+        FapFrame f = frames[a];
+        for (std::size_t i = 2; i < kFapCount; ++i)
+            if (frames[b].mask[i]) f.values[i] += (frames[b].values[i] - f.values[i]) * t;
+        std::bitset<kFapCount> low_level = frames[b].mask;
+        f.mask |= low_level.reset(0).reset(1);
+        out[k] = f;
+    }
+    return out;
+}
+
+}  // namespace
+
+FapStream for_xface(const FapStream& stream) {
+    if (stream.frames.empty()) fail<InputError>("fap: for_xface: expected at least one frame, found none");
+    if (!(std::isfinite(stream.fps) && stream.fps > 0))
+        fail<InputError>("fap: for_xface: expected a positive frame rate, found {}", stream.fps);
+    FapStream out;
+    out.version = stream.version;
+    out.name = xface_name(stream.name);
+    out.warnings = stream.warnings;
+    out.fps = std::clamp(std::round(stream.fps), 1.0, kXfaceMaxFps);
+    out.frames = resolve_untransmitted(stream).frames;
+    if (out.fps != stream.fps) out.frames = resample_resolved(out.frames, stream.fps, out.fps);
+    for (std::size_t k = 0; k < out.frames.size(); ++k) {
+        FapFrame& f = out.frames[k];
+        f.number = static_cast<long long>(k);
+        for (std::size_t i = 2; i < kFapCount; ++i) {
+            // -0 would read back as 0 but print as "-0".
+            f.values[i] = f.mask[i] ? std::round(f.values[i]) + 0.0 : 0.0;
+        }
+    }
+    return out;
 }
 
 bool same_content(const FapStream& a, const FapStream& b) {

@@ -61,4 +61,24 @@ void write_fap_file(const FapStream& stream, const std::string& path);
 // Same version, name, fps and frames (warnings are not compared).
 bool same_content(const FapStream& a, const FapStream& b);
 
+// The stream as Xface's FAP reader takes it and plays it the way emoface
+// does (Xface 1.0's FAPFile::open, XFace/src/XFace/FapFile.cpp, Xface Core
+// Library, ITC-irst/FBK 2004-2008, MPL 1.1). That reader pulls
+// whitespace-separated tokens with istream >>, so:
+//  - the name is one token of at most 254 bytes (read into a char[255]):
+//    whitespace runs become '_', an empty name "emoface";
+//  - the frame rate is read into a short (or as a float truncated to one):
+//    a fractional rate is resampled at the nearest whole one (1..32767),
+//    values interpolated as FapStream::sample does;
+//  - a frame's number indexes the frame table the header's count sized,
+//    unchecked: frames are numbered 0..n-1 (emoface times frame k at k / fps
+//    whatever its number, so this changes no timing);
+//  - a FAP a frame does not transmit is 0 there (no hold): every frame
+//    transmits what it holds (resolve_untransmitted);
+//  - values are MPEG-4's integers, as Xface's own files hold them (rounded).
+// '#' lines only before the header, 68-token masks, FAP 1 as 4 values and
+// FAP 2 as 6 are what format_fap writes anyway. Throws emoface::InputError
+// for an empty stream (Xface's rewind() reads frame 0).
+FapStream for_xface(const FapStream& stream);
+
 }  // namespace emoface::fap
