@@ -107,6 +107,7 @@ namespace {
 
 constexpr std::size_t kXfaceNameBytes = 254;  // FAPFile::open reads the name into char[255]
 constexpr double kXfaceMaxFps = 32767;        // its frame rate is a short
+constexpr double kXfaceMaxValue = 2147483647;  // an int, as its viseme and expression fields are read
 
 std::string xface_name(const std::string& name) {
     std::string out;
@@ -168,6 +169,11 @@ FapStream for_xface(const FapStream& stream) {
         for (std::size_t i = 2; i < kFapCount; ++i) {
             // -0 would read back as 0 but print as "-0".
             f.values[i] = f.mask[i] ? std::round(f.values[i]) + 0.0 : 0.0;
+            // Past this the writer's shortest form has an exponent, and no
+            // face moves that far.
+            if (!(std::abs(f.values[i]) <= kXfaceMaxValue))
+                fail<InputError>("fap: for_xface: frame {}: expected FAP {} {} within +-{:g}, found {}", k, i + 1,
+                                 fap_table()[i].name, kXfaceMaxValue, f.values[i]);
         }
     }
     return out;

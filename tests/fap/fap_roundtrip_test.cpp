@@ -1,11 +1,14 @@
 // The writer: what it writes reads back as the same stream; what the format
 // cannot carry is refused; files are replaced whole.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <random>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include <unistd.h>
 
@@ -177,6 +180,88 @@ TEST(FapRoundTrip, WriteFileReplacesWholeAndLeavesNoTemporary) {
     for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir)) ++entries;
     EXPECT_EQ(entries, 1u);
     fs::remove_all(dir);
+}
+
+// for_xface (fap_io.h): what Xface's reader needs, on generated streams:
+// a one-token name, a whole frame rate, frames numbered 0..n-1, integer
+// values, masks that never drop a FAP; at a whole rate, each frame as
+// emoface resolves it, rounded.
+TEST(ForXface, GeneratedStreams) {
+    std::mt19937 rng(77);
+    for (int trial = 0; trial < 200; ++trial) {
+        SCOPED_TRACE(trial);
+        FapStream s = random_stream(rng);
+        if (s.frames.empty()) continue;
+        for (FapFrame& f : s.frames)
+            for (std::size_t i = 2; i < kFapCount; ++i) f.values[i] = std::clamp(f.values[i], -1e6, 1e6);
+        const FapStream x = for_xface(s);
+        EXPECT_FALSE(x.name.empty());
+        EXPECT_EQ(x.name.find_first_of(" \t\r\n"), std::string::npos) << x.name;
+        EXPECT_EQ(x.fps, std::max(1.0, std::round(s.fps)));
+        const FapStream back = parse_fap(format_fap(x), "x.fap");
+        ASSERT_TRUE(same_content(x, back));
+        const FapStream resolved = resolve_untransmitted(s);
+        if (x.fps == s.fps) ASSERT_EQ(x.frames.size(), s.frames.size());
+        for (std::size_t k = 0; k < x.frames.size(); ++k) {
+            const FapFrame& f = x.frames[k];
+            EXPECT_EQ(f.number, static_cast<long long>(k));
+            if (k > 0) EXPECT_EQ((x.frames[k - 1].mask & ~f.mask).none(), true) << "frame " << k;
+            for (std::size_t i = 2; i < kFapCount; ++i) {
+                if (!f.mask[i]) continue;
+                EXPECT_EQ(f.values[i], std::round(f.values[i]));
+                EXPECT_FALSE(std::signbit(f.values[i]) && f.values[i] == 0) << "-0 at FAP " << i + 1;
+                if (x.fps == s.fps) EXPECT_EQ(f.values[i], std::round(resolved.frames[k].values[i]) + 0.0);
+            }
+            if (x.fps == s.fps) EXPECT_EQ(f.mask, resolved.frames[k].mask);
+        }
+    }
+}
+
+TEST(ForXface, NamesRatesAndRefusals) {
+    struct Case {
+        std::string name, expected;
+    };
+    for (const Case& c : std::vector<Case>{{"my take", "my_take"},
+                                           {"  a \t b  ", "a_b"},
+                                           {"", "emoface"},
+                                           {" \t ", "emoface"},
+                                           {"C:\\Users\\x y\\TempFile", "C:\\Users\\x_y\\TempFile"},
+                                           {std::string(300, 'x'), std::string(254, 'x')},
+                                           // Not cut inside a two-byte UTF-8 letter.
+                                           {std::string(253, 'x') + "\xc3\xa9", std::string(253, 'x')}}) {
+        FapStream s;
+        s.name = c.name;
+        s.frames.resize(1);
+        s.frames[0].set(3, 1);
+        EXPECT_EQ(for_xface(s).name, c.expected) << c.name;
+    }
+    // 12.5 fps for 5 frames (0.4 s) plays at 13 fps: 5 frames, each the
+    // stream sampled at its time.
+    FapStream s;
+    s.fps = 12.5;
+    for (int k = 0; k < 5; ++k) {
+        s.frames.emplace_back();
+        s.frames.back().number = 1 + 2 * k;
+        s.frames.back().set(3, 100.0 * k);
+    }
+    const FapStream x = for_xface(s);
+    EXPECT_EQ(x.fps, 13);
+    ASSERT_EQ(x.frames.size(), 5u);
+    for (std::size_t k = 0; k < 5; ++k) {
+        EXPECT_EQ(x.frames[k].number, static_cast<long long>(k));
+        EXPECT_EQ(x.frames[k].get(3), std::round(s.sample(double(k) / 13).get(3))) << k;
+    }
+    // A rate under 1 plays at 1.
+    s.fps = 0.2;
+    EXPECT_EQ(for_xface(s).fps, 1);
+    EXPECT_EQ(for_xface(s).frames.size(), 25u);
+
+    FapStream empty;
+    EXPECT_THROW(for_xface(empty), InputError);
+    FapStream huge;
+    huge.frames.resize(1);
+    huge.frames[0].set(3, 1e12);
+    EXPECT_THROW(for_xface(huge), InputError);
 }
 
 }  // namespace

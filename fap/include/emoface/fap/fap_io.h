@@ -78,7 +78,8 @@ bool same_content(const FapStream& a, const FapStream& b);
 //  - values are MPEG-4's integers, as Xface's own files hold them (rounded).
 // '#' lines only before the header, 68-token masks, FAP 1 as 4 values and
 // FAP 2 as 6 are what format_fap writes anyway. Throws emoface::InputError
-// for an empty stream (Xface's rewind() reads frame 0).
+// for an empty stream (Xface's rewind() reads frame 0) and for a value that
+// is not finite or lies beyond an int's range.
 FapStream for_xface(const FapStream& stream);
 
 }  // namespace emoface::fap
