@@ -223,7 +223,8 @@ int main(int argc, char** argv) {
         // Pass 1: whole frames, nothing but the final fence synchronises.
         // The host's share: the frame's parameters (update) and everything
         // up to the draw's submission; the fence's wait is the GPU's.
-        Series whole, host_update, host_submit;
+        // With the GPU geometry, update()'s host stages too (FrameStageTimes).
+        Series whole, host_update, host_submit, update_layout_s, update_geometry_s, update_morph_s;
         for (long i = 0; i < warmup + frames; ++i) {
             const auto t0 = Clock::now();
             const expression::FaceState st = state_of(frame_at(i));
@@ -240,6 +241,10 @@ int main(int argc, char** argv) {
                 whole.add(ms(Clock::now() - t0));
                 host_update.add(ms(t2 - t1));
                 host_submit.add(ms(t3 - t0));
+                const render::FrameStageTimes times = scene.last_times();
+                update_layout_s.add(times.layout_ms);
+                update_geometry_s.add(times.rig_ms);
+                update_morph_s.add(times.morph_ms);
             }
         }
 
@@ -331,29 +336,27 @@ int main(int argc, char** argv) {
         }
         glDeleteQueries(1, &query);
 
-        // Pass 2b (CUDA morph and geometry): update() as pass 1 runs it, the
-        // morph and the geometry on their two streams between one mapping of
-        // the texture and the vertex buffers and one unmapping, timed by CUDA
-        // events on the morph's stream (which the unmapping waits on).
-        Series update_gpu_s;
+        // Pass 2c (CUDA morph): the morph's kernels alone, into the texture
+        // mapped once for all frames (the last frame's layout, each frame's
+        // weights), CUDA events around each frame's launches.
+        Series morph_alone_s;
 #if EMOFACE_BENCH_CUDA
-        if (cuda && geometry_stream) {
-            const auto s = static_cast<cudaStream_t>(scene.morpher().cuda_stream());
+        if (cuda) {
+            void* stream_ptr = scene.morpher().cuda_stream();
+            const auto s = static_cast<cudaStream_t>(stream_ptr);
+            const morph::Layout target = scene.target_layout();
+            const unsigned long long surface = scene.wrinkle_texture().map_surface(stream_ptr);
             for (long i = 0; i < warmup + frames; ++i) {
-                const expression::FaceState state = state_of(frame_at(i));
-                const std::vector<float> w = render::key_weights(assets->keys, state);
+                const std::vector<float> w = render::key_weights(assets->keys, state_of(frame_at(i)));
                 cudaEventRecord(ev0, s);
-                scene.update(state.faps, w);
+                scene.morpher().morph_to_surface(target, w, scene.morph_params(), surface);
                 cudaEventRecord(ev1, s);
                 cudaEventSynchronize(ev1);
                 float e = 0;
                 cudaEventElapsedTime(&e, ev0, ev1);
-                platform.begin_frame();
-                scene.draw(draw);
-                platform.end_frame();
-                fence();
-                if (i >= warmup) update_gpu_s.add(e);
+                if (i >= warmup) morph_alone_s.add(e);
             }
+            scene.wrinkle_texture().unmap(stream_ptr);
         }
 #endif
 
@@ -423,9 +426,9 @@ int main(int argc, char** argv) {
         row("  of which kernels alone (no interop)", kernels_alone_s.median(), kernels_alone_s.pct(0.9));
         row("  of which the rig kernel alone", rig_alone_s.median(), rig_alone_s.pct(0.9));
         row("GPU: morph (map + kernel + unmap)", morph_s.median(), morph_s.pct(0.9));
+        row("  of which the morph's kernels alone (no interop)", morph_alone_s.median(), morph_alone_s.pct(0.9));
         row("GPU: compute (geometry + morph, medians)", geometry_gpu_s.median() + morph_s.median(),
             geometry_gpu_s.pct(0.9) + morph_s.pct(0.9));
-        row("GPU: compute as update() runs it (one mapping)", update_gpu_s.median(), update_gpu_s.pct(0.9));
         row("draw (GL time, + MSAA resolve)", draw_s.median(), draw_s.pct(0.9));
         row("whole frame (sample .. fence)", whole.median(), whole.pct(0.9));
         std::printf("  whole frame - draw: %.3f ms (medians)\n", whole.median() - draw_s.median());
@@ -438,6 +441,12 @@ int main(int argc, char** argv) {
         row("wrinkle UVs (vertices projected)", uv_s.median(), uv_s.pct(0.9));
         row("tangent frames", tangents_s.median(), tangents_s.pct(0.9));
         row("vertex upload", upload_s.median(), upload_s.pct(0.9));
+        if (scene.uses_gpu_geometry() && scene.uses_interop()) {
+            // update() as pass 1 ran it: one mapping for the morph and the geometry.
+            row("update(), host: rig frame + layout L*", update_layout_s.median(), update_layout_s.pct(0.9));
+            row("update(), host: one map + geometry launches", update_geometry_s.median(), update_geometry_s.pct(0.9));
+            row("update(), host: morph launches + one unmap", update_morph_s.median(), update_morph_s.pct(0.9));
+        }
         row("interop map (host)", map_s.median(), map_s.pct(0.9));
         row("interop unmap (host)", unmap_s.median(), unmap_s.pct(0.9));
         std::printf("  interop map+unmap per frame: %.1f us (median)\n",

@@ -312,6 +312,7 @@ bool FaceScene::uses_interop() const { return wrinkle_morph_->uses_interop(); }
 int FaceScene::key_count() const { return morpher_->keys(); }
 
 void FaceScene::update(const expression::FapValues& faps, const std::vector<float>& key_weights) {
+    if (cuda_geometry_ && wrinkle_morph_->uses_interop()) return update_on_gpu(faps, key_weights);
     // The layout needs only the feature points (cheap), so the morph is
     // queued first: on the CUDA backend it then runs on the GPU while the
     // CPU deforms the mesh and uploads it (the draw waits for both).
@@ -321,12 +322,8 @@ void FaceScene::update(const expression::FapValues& faps, const std::vector<floa
         target_ = to_morph_layout(expression::layout_segments(lines_, layout_));
     }
     const double layout_ms = ms_since(t);
-    if (cuda_geometry_ && wrinkle_morph_->uses_interop()) {
-        update_on_gpu(faps, key_weights);
-    } else {
-        update_wrinkles(key_weights);
-        deform(faps, /*layout_from_mesh=*/false);
-    }
+    update_wrinkles(key_weights);
+    deform(faps, /*layout_from_mesh=*/false);
     times_.layout_ms = layout_ms;
 }
 
@@ -338,14 +335,20 @@ void FaceScene::update_on_gpu(const expression::FapValues& faps, const std::vect
     // between GL and CUDA that costs the GPU more than the geometry's kernels.
     platform_.make_current();
     auto t = Clock::now();
-    frame_ = rig_.frame(faps);
+    frame_ = rig_.frame(faps);  // the layout's feature points from it too: the rig's frame once
+    if (layout_kind_ == WrinkleLayout::Projective) {
+        layout_ = layout_of(rig_.feature_points(frame_), present_points(face_), box_);
+        target_ = to_morph_layout(expression::layout_segments(lines_, layout_));
+    }
+    times_.layout_ms = ms_since(t);  // host time: the rig's parameters and the layout
+    t = Clock::now();
     void* morph_stream = morpher_->cuda_stream();
     const std::vector<void*>& buffers = geometry_buffers_->resources();
     const unsigned long long surface = texture_->map_surface(morph_stream, buffers);
     try {
         cuda_geometry_->wait_for(morph_stream);
         run_gpu_geometry(geometry_buffers_->pointers());
-        times_.rig_ms = ms_since(t);  // host time: parameters, map, launches
+        times_.rig_ms = ms_since(t);  // host time: map, launches
         t = Clock::now();
         morpher_->morph_to_surface(target_, key_weights, params_, surface);
         cuda_geometry_->join_into(morph_stream);
@@ -357,7 +360,7 @@ void FaceScene::update_on_gpu(const expression::FapValues& faps, const std::vect
         throw;
     }
     texture_->unmap(morph_stream, buffers);
-    times_.morph_ms = ms_since(t);
+    times_.morph_ms = ms_since(t);  // host time: the morph's launches, unmap
     times_.uv_ms = times_.tangents_ms = times_.upload_ms = 0.0;
 }
 
