@@ -1,8 +1,9 @@
 // `emoface play --out VIDEO --audio SOUND` end to end, the files read back
 // through libavformat (tests/render/media_probe.h): H.264 + AAC of matching
-// length, a millisecond-stamped FAP file's frame times kept, --frames slices
-// that join to the whole with their sound, and bad sound files or options
-// refused with one line, exit 2 and nothing written.
+// length, a millisecond-stamped FAP file's frame times kept, a capture CSV
+// played as a video, --frames slices that join to the whole with their sound,
+// and bad sound files or options refused with one line, exit 2 and nothing
+// written.
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -102,6 +103,26 @@ TEST_F(PlayVideo, AMillisecondStampedFileKeepsItsFrameTimes) {
         EXPECT_NEAR(v->time(k), double(k) / 30, 1e-9) << "frame " << k;
         EXPECT_NEAR(v->time(k) * 1000, double(stamps[k]), 0.5) << "frame " << k;
     }
+}
+
+// Issue 14's acceptance: a hand-written OpenFace 2.0 CSV (a smile growing, the
+// older header's leading spaces) plays as a video at its rows' rate.
+TEST_F(PlayVideo, ACaptureCsvPlaysAsAVideo) {
+    std::string csv = "frame, face_id, timestamp, confidence, success, pose_Rx, pose_Ry, pose_Rz, AU06_r, AU12_r\n";
+    for (int k = 0; k < 6; ++k)
+        csv += std::to_string(k + 1) + ", 0, " + std::to_string(k * 0.04) + ", 0.98, 1, 0, 0.05, 0, " +
+               std::to_string(k * 0.6) + ", " + std::to_string(k * 0.8) + "\n";
+    const std::string file = scratch_.write("smile.csv", csv);
+    const CommandResult r = run_emoface(args_with({"play", file, "--out", out("c.mp4")}, kSmall));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("6 frames 96x72 at 25 frames/s, H.264 MP4"), std::string::npos) << r.out;
+    const Media m = probe_media(out("c.mp4"));
+    ASSERT_EQ(m.streams.size(), 1u);
+    const MediaStream* v = m.first(AVMEDIA_TYPE_VIDEO);
+    ASSERT_TRUE(v);
+    EXPECT_EQ(v->codec, "h264");
+    EXPECT_EQ(v->pts.size(), 6u);
+    EXPECT_NEAR(v->seconds(), 0.24, 1e-6);
 }
 
 // --frames 0:4 and 4:10 with the same sound and offset, joined by FFmpeg's
