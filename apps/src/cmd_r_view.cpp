@@ -23,7 +23,7 @@ struct ViewArgs {
 void add_view_command(CLI::App& root) {
     auto* sub = root.add_subcommand(
         "view",
-        "Open the interactive viewer: orbit/zoom with the mouse, emotion sliders, FAP timeline,\n"
+        "Open the interactive viewer: orbit/zoom with the mouse, emotion sliders, an animation file's timeline,\n"
         "wrinkles, feature points and lines, CPU/GPU morph (needs a display)");
     auto args = std::make_shared<ViewArgs>();
     sub->add_option("file", args->viewer.fap_path,
