@@ -360,6 +360,15 @@ void FaceRig::build_point_field(const Face& face, double radius_scale) {
 
     // The lid field: the margin moves by (opening here / opening at the
     // feature point) times the lid FAP, the lid skin beyond it less and less.
+    // The held margins still take a share of the brows' wide kernels, so a
+    // brow raise (AU1+2) dragged the upper margin up by over half its own
+    // rise and bared a band of white above the iris: a stare. The levator,
+    // not the frontalis, lifts the margin; the brow lifts the skin above the
+    // lid fold. So the brows' weights on the upper lid are shielded, fully
+    // at the margin and fading out over the lid's height (the lid fold, 8-12
+    // mm up); the inner lid's own share of the brow is the rule below.
+    constexpr double kBrowShield = 0.9;
+    std::vector<double> brow_shield(n, 0.0);
     for (int k = 0; k < fap::kFeaturePointCount; ++k) {
         const auto id = fap::feature_points()[k].id;
         if (!is_lid(id) || !fps_[k].present || fps_[k].vertex < 0) continue;
@@ -380,6 +389,7 @@ void FaceRig::build_point_field(const Face& face, double radius_scale) {
         const double fade = (upper ? 0.14 : 0.17) * es0 * radius_scale;
         const int lid = static_cast<int>(lid_fps_.size());
         lid_fps_.push_back(k);
+        lid_bulge_.push_back(0);
         for (auto [v, g] : graph.within({src}, 0.35 * es0 * radius_scale)) {
             if (parts_[v] != VertexPart::Skin) continue;
             const double x = neutral_[v][0], y = neutral_[v][1];
@@ -389,8 +399,32 @@ void FaceRig::build_point_field(const Face& face, double radius_scale) {
             if (h < -1e-3) continue;
             const double w = std::min(opening(x) / o_fp, 1.0) * raised_cosine(std::max(h, 0.0) / fade);
             if (w > 1e-5) lid_weights_.push_back({v, lid, static_cast<float>(v == src ? 1.0 : w)});
+            if (upper)
+                brow_shield[v] = std::max(brow_shield[v], kBrowShield * std::min(opening(x) / o_fp, 1.0) *
+                                                              raised_cosine(std::max(h, 0.0) / (1.2 * fade)));
         }
-        if (!upper) continue;
+        if (!upper) {
+            // As the lower margin rises (AU6, AU7), the skin below it
+            // bunches into a bulge (FACS: the lower-lid bulge, the "bags"
+            // of the Duchenne smile): pushed forward by up to kBulge of the
+            // margin's rise, most a third of the lid's height below the
+            // margin and nothing at the margin or past the lid's skin.
+            constexpr double kBulge = 0.45;
+            const int bulge = static_cast<int>(lid_fps_.size());
+            lid_fps_.push_back(k);
+            lid_bulge_.push_back(1);
+            for (auto [v, g] : graph.within({src}, 0.35 * es0 * radius_scale)) {
+                if (parts_[v] != VertexPart::Skin) continue;
+                const double x = neutral_[v][0], y = neutral_[v][1];
+                double ym;
+                if (!margin_y(margin, x, &ym) || ym - y < 1e-3) continue;
+                const double t = (ym - y) / (1.2 * fade);
+                if (t >= 1.0) continue;
+                const double w = kBulge * std::min(opening(x) / o_fp, 1.0) * std::pow(std::sin(kPi * std::pow(t, 0.75)), 2);
+                if (w > 1e-5) lid_weights_.push_back({v, bulge, static_cast<float>(w)});
+            }
+            continue;
+        }
         // The upper lid's inner part follows the inner brow (FACS: AU1
         // draws the inner upper lid up with the brow, AU4 pushes it down and
         // in): the oblique lid of the sad eye. The share peaks a third of
@@ -401,6 +435,7 @@ void FaceRig::build_point_field(const Face& face, double radius_scale) {
         const double x_inner = margin.front()[0], x_outer = margin.back()[0];
         const int follow = static_cast<int>(lid_fps_.size());
         lid_fps_.push_back(brow);
+        lid_bulge_.push_back(0);
         for (auto [v, g] : graph.within({src}, 0.35 * es0 * radius_scale)) {
             if (parts_[v] != VertexPart::Skin) continue;
             const double x = neutral_[v][0], y = neutral_[v][1];
@@ -410,6 +445,12 @@ void FaceRig::build_point_field(const Face& face, double radius_scale) {
             const double w = kBrowFollow * 6.75 * t * (1 - t) * (1 - t) * raised_cosine(std::max(y - ym, 0.0) / fade);
             if (w > 1e-5) lid_weights_.push_back({v, follow, static_cast<float>(w)});
         }
+    }
+    for (int v = 0; v < n; ++v) {
+        if (brow_shield[v] <= 0.0) continue;
+        for (int k = influence_start_[v]; k < influence_start_[v + 1]; ++k)
+            if (fap::feature_points()[system_fps_[weights_[k].system]].group == 4)
+                weights_[k].weight *= static_cast<float>(1.0 - brow_shield[v]);
     }
 }
 
@@ -464,7 +505,10 @@ void FaceRig::build_jaw(const Face& face) {
         }
         double w = glm::smoothstep(delta, -delta, y - line);
         if (to_upper[v] < 1e29 || to_lower[v] < 1e29) {
-            const double lip = 1.0 - glm::smoothstep(0.6 * half_width, 1.1 * half_width, std::abs(x - mx));
+            // Fully on the jaw (lower lip) or off it (upper) only mid-mouth:
+            // towards the corners both lips follow it partly, so an open
+            // mouth is an oval narrowing into closed corners, not a slot.
+            const double lip = 1.0 - glm::smoothstep(0.3 * half_width, 1.1 * half_width, std::abs(x - mx));
             w = to_lower[v] < to_upper[v] ? std::max(w, lip) : std::min(w, 1.0 - lip);
         }
         // The neck below the chin and the head behind the jaw joint stay; the
@@ -534,7 +578,7 @@ void FaceRig::build_eyes(const Face& face) {
     // (Only the lid FAPs turn skin about the eye; the inner brow's share
     // of the upper lid moves it as the brow moves the skin above.)
     for (const LidWeight& lw : lid_weights_)
-        if (fap::feature_points()[lid_fps_[lw.lid]].id[0] == '3')
+        if (fap::feature_points()[lid_fps_[lw.lid]].id[0] == '3' && !lid_bulge_[lw.lid])
             follow[lw.vertex] = std::max(follow[lw.vertex], lw.weight);
     for (int v = 0; v < static_cast<int>(neutral_.size()); ++v) {
         if (parts_[v] != VertexPart::Skin) continue;
@@ -662,6 +706,11 @@ RigView FaceRig::view() const {
     return r;
 }
 
+std::array<double, 3> FaceRig::lid_displacement(std::size_t i, const std::array<double, 3>& fp) const {
+    if (!lid_bulge_[i]) return fp;
+    return {0.0, 0.0, std::max(fp[1], 0.0)};  // a lower margin's rise, forward
+}
+
 RigFrame FaceRig::frame(const FapValues& given) const {
     const FapValues faps = lip_contours_together(ranges_.clamp(given));
     RigFrame f;
@@ -681,8 +730,9 @@ RigFrame FaceRig::frame(const FapValues& given) const {
         f.points |= nonzero(fp_d[k]);
     }
     for (std::size_t i = 0; i < lid_fps_.size(); ++i) {
-        for (int c = 0; c < 3; ++c) f.lid_d[i][c] = fp_d[lid_fps_[i]][c];
-        f.lids |= nonzero(fp_d[lid_fps_[i]]);
+        const std::array<double, 3> d = lid_displacement(i, fp_d[lid_fps_[i]]);
+        for (int c = 0; c < 3; ++c) f.lid_d[i][c] = d[c];
+        f.lids |= nonzero(d);
     }
 
     // Jaw: rotate about the pivot so that 2.1 drops by FAP 3 x MNS, then
@@ -840,7 +890,7 @@ DeformedFace FaceRig::deform_reference(const FapValues& given) const {
     for (int k : lid_fps_) lids_move |= fp_d[k][0] != 0 || fp_d[k][1] != 0 || fp_d[k][2] != 0;
     if (lids_move)
         for (const LidWeight& lw : lid_weights_) {
-            const auto& dk = fp_d[lid_fps_[lw.lid]];
+            const std::array<double, 3> dk = lid_displacement(lw.lid, fp_d[lid_fps_[lw.lid]]);
             pos[lw.vertex] += TriMesh::Point(static_cast<float>(lw.weight * dk[0]), static_cast<float>(lw.weight * dk[1]),
                                              static_cast<float>(lw.weight * dk[2]));
         }

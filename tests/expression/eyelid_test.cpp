@@ -93,7 +93,7 @@ TEST(Eyelids, MarginsSitOnTheIrisAtRestAndMoveWithTheLidAus) {
         // The levator bares white above the iris; the lower lid stays.
         {"AU5 upper lid raiser", 5, -kAny, -0.1, 0.0, 0.1, -0.02, -kAny, kAny},
         // The orbital orbicularis lifts the lower lid and the skin below it.
-        {"AU6 cheek raiser", 6, 0.1, kAny, 0.1, kAny, 0.08, 0.08, kAny},
+        {"AU6 cheek raiser", 6, 0.1, kAny, 0.2, kAny, 0.2, 0.08, kAny},
         // The palpebral orbicularis raises and tightens the lower lid over the iris.
         {"AU7 lid tightener", 7, 0.1, kAny, 0.1, kAny, 0.1, -kAny, kAny},
         // The upper lid comes down onto the lower one all along.
@@ -157,6 +157,37 @@ TEST(Eyelids, TheUpperLidsInnerPartFollowsTheInnerBrow) {
     }
     // The lid FAPs alone keep the margin's shape (no tilt from the brow field).
     EXPECT_LT(std::abs(inner_lid_tilt(au_faps(5))), 0.05);
+}
+
+// The emotions' lids: fear and surprise bare white above the iris (AU5) but
+// no more than a few millimetres of it, and none below (a white ring reads
+// as a stare; the brows' raise must not carry the upper margin with it);
+// joy's AU6 and anger's AU7 raise the lower lid over the iris; sadness
+// shows next to no white above the iris (its inner lid rises with the brow).
+TEST(Eyelids, EmotionsShowWhiteAboveTheIrisOnlyWhereTheirAusSaySo) {
+    constexpr double kAny = 1e9;
+    struct Case {
+        Emotion emotion;
+        double upper_min, upper_max, lower_min, lower_max;
+    };
+    const Case cases[] = {
+        {Emotion::Joy, 0.1, kAny, 0.2, kAny},
+        {Emotion::Sadness, -0.05, kAny, 0.0, kAny},
+        {Emotion::Anger, 0.0, kAny, 0.1, kAny},
+        {Emotion::Fear, -0.35, -0.1, 0.0, kAny},
+        {Emotion::Disgust, 0.1, kAny, 0.1, kAny},
+        {Emotion::Surprise, -0.45, -0.15, 0.0, kAny},
+    };
+    for (const Case& c : cases) {
+        const LidReading r = read_lids(profiles()[c.emotion]);
+        std::printf("%-9s upper cover %+.2f IRISD, lower cover %+.2f IRISD\n", emotion_name(c.emotion), r.upper_cover,
+                    r.lower_cover);
+        SCOPED_TRACE(emotion_name(c.emotion));
+        EXPECT_GE(r.upper_cover, c.upper_min);
+        EXPECT_LE(r.upper_cover, c.upper_max);
+        EXPECT_GE(r.lower_cover, c.lower_min);
+        EXPECT_LE(r.lower_cover, c.lower_max);
+    }
 }
 
 }  // namespace

@@ -172,6 +172,11 @@ private:
     // Eyes and eyelids.
     std::vector<EyeState> eyes_;
     std::vector<int> lid_fps_;              // 3.1-3.4 where the face has eyelid margins
+    // Per lid_fps_ entry: true where it is a lower lid's bulge (the skin
+    // below the margin pushed forward as the margin rises), not its motion.
+    std::vector<char> lid_bulge_;
+    // Entry i's displacement, from the feature points' displacements.
+    std::array<double, 3> lid_displacement(std::size_t i, const std::array<double, 3>& fp) const;
     std::vector<LidWeight> lid_weights_;
     std::vector<LidVertex> lid_vertices_;
     // Eyelashes: a strand whose first vertex is welded to a lid margin
