@@ -852,8 +852,17 @@ void Generator::place_feature_points(Face& face) {
         placed[k] = true;
     };
     auto mirror = [&](int i) { return 2 * centre_col_ - i; };
-    auto px = [&](int v) { return static_cast<double>(face.mesh.point(TriMesh::VertexHandle(v))[0]); };
-    auto py = [&](int v) { return static_cast<double>(face.mesh.point(TriMesh::VertexHandle(v))[1]); };
+    // Points are chosen where the symmetric face has its vertices (the
+    // shape's asymmetry taken off), so the two sides get mirrored columns
+    // and rows and no two points share a vertex; they sit where the
+    // vertices are.
+    auto symmetric = [&](int v) {
+        const auto q = face.mesh.point(TriMesh::VertexHandle(v));
+        const glm::dvec3 p{q[0], q[1], q[2]};
+        return p - shape_.asymmetry(p);
+    };
+    auto px = [&](int v) { return symmetric(v).x; };
+    auto py = [&](int v) { return symmetric(v).y; };
     // Front column whose vertex on row j is nearest x (left side, x > 0).
     auto col_near = [&](double x, int j) {
         int best = centre_col_;
@@ -935,8 +944,7 @@ void Generator::place_feature_points(Face& face) {
         int best = 0;
         double best_d = std::numeric_limits<double>::max();
         for (int v = 0; v < skin_end; ++v) {
-            const auto q = face.mesh.point(TriMesh::VertexHandle(v));
-            const double d = glm::length(glm::dvec3{q[0] - t.x, q[1] - t.y, q[2] - t.z});
+            const double d = glm::length(symmetric(v) - t);
             if (d < best_d) {
                 best_d = d;
                 best = v;

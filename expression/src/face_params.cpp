@@ -112,6 +112,8 @@ FaceParams read_face_params(const std::string& params_dir) {
             p.hair_volume.sides = hv.number_in("sides", 0.0, 40.0);
             p.hair_volume.nape = hv.number_in("nape", 0.0, 40.0);
             p.hair_volume.fade = hv.number_in("fade", 0.5, 60.0);
+            p.hair_volume.lumps = hv.number_in("lumps", 0.0, 0.8);
+            p.hair_volume.lump_size = hv.number_in("lump_mm", 2.0, 100.0);
             hv.finish();
             r.finish();
         }
@@ -218,6 +220,12 @@ FaceParams read_face_params(const std::string& params_dir) {
             r.finish();
         }
         {
+            JsonReader r = top.object("asymmetry");
+            p.asymmetry_mm = r.number_in("shape_mm", 0.0, 4.0);
+            p.asymmetry_albedo = r.number_in("albedo", 0.0, 0.3);
+            r.finish();
+        }
+        {
             JsonReader r = top.object("pivots");
             p.jaw_pivot = to_glm(r.numbers<3>("jaw"));
             p.head_pivot = to_glm(r.numbers<3>("head"));
@@ -273,11 +281,20 @@ FaceParams read_face_params(const std::string& params_dir) {
             p.sideburn_z = r.number("sideburn_z");
             p.sideburn_bottom_y = r.number("sideburn_bottom_y");
             p.hair_back_bottom_y = r.number("back_bottom_y");
+            {
+                JsonReader rc = r.object("recession");
+                p.hair_recession = {rc.number_in("x", 0.0, 80.0), rc.number_in("rise", 0.0, 40.0),
+                                    rc.number_in("width", 1.0, 60.0)};
+                rc.finish();
+            }
+            p.hairline_wander = r.number_in("wander_mm", 0.0, 10.0);
+            p.temple_depth = r.number_in("temple_depth", 1.0, 100.0);
             p.hair_crown = to_glm(r.numbers<3>("crown"));
             p.hairline_band = r.number_in("hairline_band", 0.0, 30.0);
             p.hair_strand_width = r.number_in("strand_width", 0.05, 5.0);
             p.hair_strand_length = r.number_in("strand_length", 0.5, 100.0);
             p.hair_tip_lightening = r.number_in("tip_lightening", 0.0, 1.0);
+            p.hair_swirl = r.number_in("swirl_deg", -180.0, 180.0) * 3.14159265358979323846 / 180.0;
             r.finish();
         }
         {
@@ -302,6 +319,20 @@ FaceParams read_face_params(const std::string& params_dir) {
                 a.freckle_size = f.number_in("size_mm", 0.05, 10.0);
                 a.freckle_strength = f.number_in("strength", 0.0, 1.0);
                 f.finish();
+            }
+            {
+                JsonReader g = r.object("pores");
+                a.pore_size = g.number_in("size_mm", 0.1, 5.0);
+                a.pore_strength = g.number_in("strength", 0.0, 0.3);
+                g.finish();
+            }
+            for (auto [key, spots] : {std::pair{"blemishes", &a.blemishes}, std::pair{"moles", &a.moles}}) {
+                JsonReader g = r.object(key);
+                spots->spacing = g.number_in("spacing_mm", 0.5, 200.0);
+                spots->chance = g.number_in("chance", 0.0, 1.0);
+                spots->size = g.number_in("size_mm", 0.05, 10.0);
+                spots->strength = g.number_in("strength", 0.0, 1.0);
+                g.finish();
             }
             auto tint = [](JsonReader t, glm::dvec3* colour, double* amount) {
                 *colour = to_glm(t.numbers<3>("tint"));

@@ -101,9 +101,12 @@ struct FaceParams {
     Ellipsoid shoulders;
     double shoulders_blend = 0.0;
     // the hair's volume off the scalp (mm) over the crown, on the sides and
-    // at the nape, and over how many mm above the hairline it grows to that
+    // at the nape, and over how many mm above the hairline it grows to that; lumps: +-
+    // that fraction of it in tufts about lump_size mm across, so the
+    // silhouette is not one smooth shell
     struct HairVolume {
         double top = 0.0, sides = 0.0, nape = 0.0, fade = 1.0;
+        double lumps = 0.0, lump_size = 1.0;
     } hair_volume;
 
     // eyes (left eye; the right one mirrors it)
@@ -159,6 +162,11 @@ struct FaceParams {
     double ear_tilt_deg = 0.0;
     double ear_height = 0.0;
 
+    // the face's natural asymmetry: its largest shape offset (mm; 0 gives a
+    // mirror-symmetric face) and how far the two halves' colour differs
+    // (a fraction of the flush and tone)
+    double asymmetry_mm = 0.0, asymmetry_albedo = 0.0;
+
     // pivots
     glm::dvec3 jaw_pivot{0.0};
     glm::dvec3 head_pivot{0.0};
@@ -179,10 +187,20 @@ struct FaceParams {
     double hairline_y = 0.0;
     glm::dvec2 hairline_temple{0.0};
     double sideburn_z = 0.0, sideburn_bottom_y = 0.0, hair_back_bottom_y = 0.0;
+    // the temples' recession: |x| of its deepest point, how far it rises
+    // (mm) and its half-width; how far the line wanders (mm, +-)
+    glm::dvec3 hair_recession{0.0};
+    // mm of z over which the line runs down from the temple point to the
+    // sideburn's top
+    double temple_depth = 1.0;
+    double hairline_wander = 0.0;
     // hair: the whorl the strands flow from, the width of the hairline's
     // fading band, the strands' size and the tips' lightening
     glm::dvec3 hair_crown{0.0};
     double hairline_band = 0.0, hair_strand_width = 0.0, hair_strand_length = 0.0, hair_tip_lightening = 0.0;
+    // how far the strands turn round the crown per 100 mm from it (radians;
+    // the whorl's spiral, so the front sweeps across the forehead)
+    double hair_swirl = 0.0;
     // brow hairs: spacing of their roots, length at the inner end and beyond,
     // width (mm), angle off the brow line (degrees) of the medial ones and of
     // the lateral ones above and below the line (which converge on it)
@@ -200,6 +218,13 @@ struct FaceParams {
         std::vector<Flush> flush;
         double flush_breakup = 0.0, ear_flush = 0.0;
         double freckle_spacing = 0.0, freckle_size = 0.0, freckle_strength = 0.0;
+        // pore-scale grain: its size (mm) and +- strength
+        double pore_size = 1.0, pore_strength = 0.0;
+        // sparse small spots: jittered-grid spacing (mm), chance per cell,
+        // size (mm, radius 0.5 .. 1.5 times it), strength 0..1
+        struct Spots {
+            double spacing = 1.0, chance = 0.0, size = 1.0, strength = 0.0;
+        } blemishes, moles;
         glm::dvec3 beard_tint{1.0}, forehead_tint{1.0}, periorbital_tint{1.0};
         double beard_amount = 0.0, forehead_amount = 0.0, periorbital_amount = 0.0;
         double lip_border_mm = 0.0, lip_lines = 0.0;

@@ -325,18 +325,20 @@ double FaceShape::ear_relief(double y, double z) const {
     // The helix: from the front top, round the top and down the back; not
     // along the front below its root, nor on the lobe.
     const double helix = (1.0 - glm::smoothstep(0.25, 0.7, s) * glm::smoothstep(0.45, 0.1, a)) * (1.0 - lobe);
-    h += helix * (0.16 * H * gauss(rim_d - 1.6, 1.3) - 0.16 * H * gauss(rim_d - 4.6, 1.6));
+    h += helix * (0.22 * H * gauss(rim_d - 1.7, 1.4) - 0.2 * H * gauss(rim_d - 4.8, 1.7));
     // Antihelix and its two crura, an inner ridge parallel to the rim.
     const double anti = ear_curve_distance(a, s, {{-0.55, -0.3}, {-0.1, -0.48}, {0.32, -0.42}, {0.68, 0.05}});
     const double crus = ear_curve_distance(a, s, {{0.32, -0.42}, {0.3, 0.35}});
-    h += 0.14 * H * gauss(std::min(anti, 1.1 * crus) * mm, 2.0);
+    h += 0.2 * H * gauss(std::min(anti, 1.1 * crus) * mm, 2.2);
     // Concha: a deep bowl in front of the antihelix, behind the tragus.
     const double cu = (a + 0.08) / 0.36, cv = (s - 0.2) / 0.42;
     const double bowl = std::max(0.0, 1.0 - cu * cu - cv * cv);
-    h = mix(h, 0.12 * H, glm::smoothstep(0.0, 0.6, bowl));
+    h = mix(h, 0.06 * H, glm::smoothstep(0.0, 0.6, bowl));
     // Triangular fossa between the crura: shallow.
     const double fa = (a - 0.55) / 0.18, fs = (s - 0.05) / 0.22;
-    h -= 0.08 * H * std::max(0.0, 1.0 - fa * fa - fs * fs);
+    h -= 0.1 * H * std::max(0.0, 1.0 - fa * fa - fs * fs);
+    // The lobe: soft and fleshy, fuller in its middle.
+    h += 0.12 * H * lobe * gauss(std::hypot((a + 0.82) * L, (s + 0.1) * W), 6.0);
     // Tragus over the concha's front, antitragus behind the notch below it.
     h += 0.3 * H * gauss(std::hypot((a + 0.2) * L, (s - 0.78) * W), 3.5);
     h += 0.1 * H * gauss(std::hypot((a + 0.52) * L, (s + 0.05) * W), 3.0);
@@ -349,16 +351,32 @@ double FaceShape::ear_relief(double y, double z) const {
 double FaceShape::hairline(glm::dvec3 q) const {
     const double ax = std::abs(q.x);
     const double tx = std::min(ax / p_.hairline_temple[0], 1.0);
-    const double front_line =
-        mix(p_.hairline_y, p_.hairline_temple[1], tx * tx) - std::max(ax - p_.hairline_temple[0], 0.0) * 2.5;
+    // The temples recede (the hairline's M): a rise beside the centre's
+    // rounded front, before the line comes down to the temple point.
+    const glm::dvec3& rc = p_.hair_recession;
+    const double recession = rc[1] * std::exp(-((ax - rc[0]) / rc[2]) * ((ax - rc[0]) / rc[2]));
     const double ear_top = p_.ear_centre_yz[0] + p_.ear_radii_yz[0] + 5.0;
+    // Past the temple point the line runs back and down the side of the
+    // head to the sideburn's top (over temple_depth mm of z), instead of
+    // dropping straight down the temple as a helmet's rim.
+    const double temple_side =
+        mix(ear_top, p_.hairline_temple[1], glm::smoothstep(p_.sideburn_z, p_.sideburn_z + p_.temple_depth, q.z));
+    const double front_drop = mix(p_.hairline_y, p_.hairline_temple[1], tx * tx) + recession -
+                              std::max(ax - p_.hairline_temple[0], 0.0) * 2.5;
+    const double k = 4.0;  // a smooth maximum: no corner where the two meet
+    const double front_line = 0.5 * (front_drop + temple_side + std::sqrt((front_drop - temple_side) * (front_drop - temple_side) + k * k));
     const double ear_front = p_.ear_centre_yz[1] + p_.ear_radii_yz[1] + 3.0;
     const double ear_back = p_.ear_centre_yz[1] - p_.ear_radii_yz[1] - 3.0;
     double side_line;
     if (q.z > ear_front) side_line = mix(ear_top, p_.sideburn_bottom_y, glm::smoothstep(ear_front, ear_front + 5.0, q.z));
     else if (q.z > ear_back) side_line = ear_top;
     else side_line = mix(ear_top, p_.hair_back_bottom_y, glm::smoothstep(ear_back, ear_back - 35.0, q.z));
-    return mix(side_line, front_line, glm::smoothstep(p_.sideburn_z - 6.0, p_.sideburn_z + 6.0, q.z));
+    const double line = mix(side_line, front_line, glm::smoothstep(p_.sideburn_z - 6.0, p_.sideburn_z + 6.0, q.z));
+    // The line wanders at two scales (about 9 and 3.5 mm along it), in x
+    // and z so it does on the front and the sides alike, and with the
+    // sign of x so the two sides differ: no drawn curve, no mirror image.
+    const double wander = 0.65 * noise(q.x / 9.0 + 40.0, q.z / 9.0, 1.0) + 0.35 * noise(q.x / 3.5, q.z / 3.5 + 40.0, 2.0);
+    return line + p_.hairline_wander * 2.0 * (wander - 0.5);
 }
 
 double FaceShape::hair_thickness(glm::dvec3 base, glm::dvec3 n) const {
@@ -370,6 +388,10 @@ double FaceShape::hair_thickness(glm::dvec3 base, glm::dvec3 n) const {
     const double side = std::abs(n.x);
     double t = mix(v.top, v.sides, glm::smoothstep(0.35, 0.9, side));
     t = mix(v.nape, t, glm::smoothstep(-60.0, 20.0, base.y));
+    // Tufts: the volume swells and dips by +-lumps, so the silhouette is
+    // a haircut's and not a helmet's smooth shell.
+    const glm::dvec3 l = base / v.lump_size;
+    t *= 1.0 + v.lumps * (2.0 * (0.7 * noise(l.x, l.y, l.z + 60.0) + 0.3 * noise(2.3 * l.x, 2.3 * l.y, 2.3 * l.z)) - 1.0);
     return t * glm::smoothstep(0.0, v.fade, above);
 }
 
@@ -390,7 +412,35 @@ glm::dvec3 FaceShape::displace(glm::dvec3 base) const {
     }
     const double hair = hair_thickness(base, n);
     if (hair > 0.0) p = p + n * hair;
-    return p;
+    return p + asymmetry(base);
+}
+
+// No face is its mirror image (FIDELITY.md, "Perfect, symmetric"): the
+// lower face and chin deviate a little to the face's left and the nose tip
+// the other way, the right cheek is a little fuller, the left brow and ear
+// sit a little higher. Each term is a broad smooth field (no fold), and
+// none reaches the eyelids, which must stay on the eyeballs.
+glm::dvec3 FaceShape::asymmetry(glm::dvec3 p) const {
+    const double a = p_.asymmetry_mm;
+    if (a == 0.0) return glm::dvec3{0.0};
+    auto bell = [](double d, double w) { return std::exp(-0.5 * (d / w) * (d / w)); };
+    const double front = glm::smoothstep(10.0, 50.0, p.z);
+    glm::dvec3 o{0.0};
+    // Lower face: the chin and mouth shift sideways, fading in below the
+    // nose and out down the neck.
+    o.x += a * glm::smoothstep(-35.0, -80.0, p.y) * glm::smoothstep(-150.0, -112.0, p.y) * front;
+    // The nose tip deviates the other way.
+    o.x -= 0.6 * a * bell(p.x, 10.0) * bell(p.y + 36.0, 9.0) * front;
+    // The right cheek is fuller.
+    o.z += 0.8 * a * bell(p.x + 42.0, 14.0) * bell(p.y + 28.0, 14.0) * glm::smoothstep(-8.0, -16.0, p.y) * front;
+    // The left brow and forehead sit higher, fading out above the lid crease.
+    o.y += 0.8 * a * bell(p.x - 30.0, 16.0) * bell(p.y - 24.0, 14.0) * glm::smoothstep(9.0, 15.0, p.y) * front;
+    // The left ear sits higher and stands off a little further.
+    const double ear = bell(p.y - p_.ear_centre_yz[0], 30.0) * bell(p.z - p_.ear_centre_yz[1], 30.0) *
+                       glm::smoothstep(45.0, 65.0, p.x);
+    o.y += 1.5 * a * ear;
+    o.x += 1.2 * a * ear;
+    return o;
 }
 
 }  // namespace emoface::expression::detail

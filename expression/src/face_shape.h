@@ -7,6 +7,7 @@
 // painter, which colours from the same curves (lip borders, eyelid margins).
 #include <array>
 #include <cmath>
+#include <cstdint>
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
@@ -24,6 +25,32 @@ inline glm::dvec3 normalised(const glm::dvec3& a) {
 
 inline double clamp01(double t) { return t < 0 ? 0 : (t > 1 ? 1 : t); }
 inline double mix(double a, double b, double t) { return a + (b - a) * t; }
+
+// A hash of a lattice point to [0, 1].
+inline double hash(int x, int y, int z) {
+    std::uint32_t h = static_cast<std::uint32_t>(x) * 374761393u + static_cast<std::uint32_t>(y) * 668265263u +
+                      static_cast<std::uint32_t>(z) * 2147483647u;
+    h = (h ^ (h >> 13)) * 1274126177u;
+    h ^= h >> 16;
+    return (h & 0xffffff) / static_cast<double>(0xffffff);
+}
+
+// Value noise in [0, 1], smooth (C1) between integer lattice points: the
+// painter's colour variation and the shape's irregular hairline and hair
+// volume, which must agree where they meet.
+inline double noise(double x, double y, double z = 0.0) {
+    const int xi = static_cast<int>(std::floor(x)), yi = static_cast<int>(std::floor(y)),
+              zi = static_cast<int>(std::floor(z));
+    auto fade = [](double t) { return t * t * (3 - 2 * t); };
+    const double fx = fade(x - xi), fy = fade(y - yi), fz = fade(z - zi);
+    double v[2];
+    for (int k = 0; k < 2; ++k) {
+        const double a = mix(hash(xi, yi, zi + k), hash(xi + 1, yi, zi + k), fx);
+        const double b = mix(hash(xi, yi + 1, zi + k), hash(xi + 1, yi + 1, zi + k), fx);
+        v[k] = mix(a, b, fy);
+    }
+    return mix(v[0], v[1], fz);
+}
 
 // The eye opening of the left eye in frontal coordinates (the right eye is
 // its mirror image: use |x|).
@@ -53,6 +80,12 @@ public:
 
     // The final skin position for a point on the head volume's surface.
     glm::dvec3 displace(glm::dvec3 base) const;
+
+    // The face's natural asymmetry (face.json "asymmetry"): a smooth offset
+    // of a millimetre or so, zero round the eyes, that displace() adds last.
+    // The painter takes it off a position before colouring it, so colour
+    // and relief stay together; 0 everywhere when shape_mm is 0.
+    glm::dvec3 asymmetry(glm::dvec3 p) const;
 
     // Frontal relief along z at (x, y), without the eyelid blend.
     double relief(double x, double y) const;
@@ -84,7 +117,8 @@ public:
 
     // The hairline's height (y) at a point of the head, from face.json
     // "hair" (the front line over the forehead and temples, the sideburn,
-    // over the ear, down to the nape); no noise.
+    // over the ear, down to the nape), with the temples' recession and a
+    // line that wanders by a millimetre or two, differently on each side.
     double hairline(glm::dvec3 q) const;
     // How far the hair stands off the scalp at a head-volume point with
     // outward normal n (0 below the hairline).

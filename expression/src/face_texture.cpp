@@ -24,29 +24,6 @@ Rgb operator*(Rgb a, Rgb b) { return {a.r * b.r, a.g * b.g, a.b * b.b}; }
 Rgb blend(Rgb a, Rgb b, double t) { return {mix(a.r, b.r, t), mix(a.g, b.g, t), mix(a.b, b.b, t)}; }
 Rgb from255(const glm::dvec3& c) { return {c[0] / 255.0, c[1] / 255.0, c[2] / 255.0}; }
 
-double hash(int x, int y, int z) {
-    std::uint32_t h = static_cast<std::uint32_t>(x) * 374761393u + static_cast<std::uint32_t>(y) * 668265263u +
-                      static_cast<std::uint32_t>(z) * 2147483647u;
-    h = (h ^ (h >> 13)) * 1274126177u;
-    h ^= h >> 16;
-    return (h & 0xffffff) / static_cast<double>(0xffffff);
-}
-
-// Value noise in [0, 1], smooth between integer lattice points.
-double noise(double x, double y, double z = 0.0) {
-    const int xi = static_cast<int>(std::floor(x)), yi = static_cast<int>(std::floor(y)),
-              zi = static_cast<int>(std::floor(z));
-    auto fade = [](double t) { return t * t * (3 - 2 * t); };
-    const double fx = fade(x - xi), fy = fade(y - yi), fz = fade(z - zi);
-    double v[2];
-    for (int k = 0; k < 2; ++k) {
-        const double a = mix(hash(xi, yi, zi + k), hash(xi + 1, yi, zi + k), fx);
-        const double b = mix(hash(xi, yi + 1, zi + k), hash(xi + 1, yi + 1, zi + k), fx);
-        v[k] = mix(a, b, fy);
-    }
-    return mix(v[0], v[1], fz);
-}
-
 double fbm(double x, double y, double z) {
     return 0.5 * noise(x, y, z) + 0.3 * noise(2.1 * x, 2.1 * y, 2.1 * z) + 0.2 * noise(4.3 * x, 4.3 * y, 4.3 * z);
 }
@@ -239,10 +216,10 @@ double Painter::hair(glm::dvec3 q, Rgb* colour, double* roots) const {
     // The hairline is the head's (FaceShape: the hair volume rises from the
     // same line), so paint and geometry agree.
     const double line = s_.hairline(q);
-    // Height above the hairline, its course wandering gently (low-frequency
-    // only: a saw-tooth edge reads as a wig; the fine hairs below make it
-    // irregular at the small scale).
-    double edge = q.y - line + (noise(q.x * 0.09, q.y * 0.09, q.z * 0.09 + 5.0) - 0.5) * 4.0;
+    // Height above the hairline (whose course wanders: FaceShape; a
+    // saw-tooth edge reads as a wig, the fine hairs below make it irregular
+    // at the small scale).
+    double edge = q.y - line;
     // Leave the ears bare.
     if (ax > 55 && s_.ear_relief(q.y, q.z) > 0.3) edge = std::min(edge, -4.0);
     const double band = p_.hairline_band;
@@ -260,7 +237,13 @@ double Painter::hair(glm::dvec3 q, Rgb* colour, double* roots) const {
     const glm::dvec3 axis = glm::normalize(p_.hair_crown);
     const glm::dvec3 e1 = -glm::normalize(glm::cross(axis, glm::dvec3{1.0, 0.0, 0.0}));
     const glm::dvec3 e2 = glm::cross(axis, e1);
-    const double azimuth = std::atan2(glm::dot(rel, e2), glm::dot(rel, e1));
+    // The whorl's spiral: strands turn round the crown with distance, most
+    // over the front (the hair sweeps across the forehead instead of
+    // falling straight onto it as a fringe) and not at all at the nape,
+    // so the azimuth's wrap stays there.
+    const double straight = std::atan2(glm::dot(rel, e2), glm::dot(rel, e1));
+    const double facing = std::cos(0.5 * straight);
+    const double azimuth = straight + p_.hair_swirl * (along / 100.0) * facing * facing;
     // Across in mm at a typical distance; fanning out with distance is the whorl.
     const double across = azimuth * 70.0;
     const double w = p_.hair_strand_width, len = p_.hair_strand_length;
@@ -358,8 +341,31 @@ double field(double x, double y, double cx, double cy, double sx, double sy) {
 }
 Rgb tint(Rgb c, const glm::dvec3& t, double amount) { return blend(c, c * Rgb{t[0], t[1], t[2]}, amount); }
 
+// Small round spots, one candidate per cell of a jittered grid of `spacing`
+// mm, present with `chance`, of radius 0.5 .. 1.5 times `size` mm and each
+// its own strength: 0 (none) .. 1 at (x, y). `seed` keeps sets apart.
+double spots(double x, double y, double spacing, double chance, double size, int seed) {
+    const int fx = static_cast<int>(std::floor(x / spacing)), fy = static_cast<int>(std::floor(y / spacing));
+    double spot = 0.0;
+    for (int dj = -1; dj <= 1; ++dj)
+        for (int di = -1; di <= 1; ++di) {
+            const int i = fx + di, j = fy + dj;
+            if (hash(i, j, seed) > chance) continue;
+            const double px = (i + hash(i, j, seed + 2)) * spacing, py = (j + hash(i, j, seed + 8)) * spacing;
+            const double r = size * (0.5 + hash(i, j, seed + 12));
+            spot = std::max(spot, (1.0 - glm::smoothstep(0.3 * r, r, std::hypot(x - px, y - py))) *
+                                      (0.4 + 0.6 * hash(i, j, seed + 18)));
+        }
+    return spot;
+}
+
 Texel Painter::skin(glm::dvec3 q) const {
+    // Colour where the symmetric face's curves put it: the shape's
+    // asymmetry carries the colour with it.
+    q -= s_.asymmetry(q);
     const FaceParams::Albedo& al = p_.albedo;
+    // -1 (the face's right) .. 1 (its left): the halves' colouring differs.
+    const double half = std::clamp(q.x / 25.0, -1.0, 1.0) * p_.asymmetry_albedo;
     const Rgb skin = from255(p_.skin);
     double gloss = 1.0;
     // Gentle pigment variation at two scales (MATTS: even skin reads young,
@@ -368,9 +374,17 @@ Texel Painter::skin(glm::dvec3 q) const {
     // Both have a broad component (tens of mm: the blotchiness seen at a
     // glance) under the finer one.
     const double pigment = 0.6 * fbm(q.x * 0.08, q.y * 0.08, q.z * 0.08) + 0.4 * noise(q.x * 0.03, q.y * 0.03, q.z * 0.03 + 21.0);
-    Rgb c = skin * (1.0 + al.pigment_variation * (pigment - 0.5));
+    Rgb c = skin * (1.0 + al.pigment_variation * (pigment - 0.5) - 0.5 * half);
     const double blood = 0.55 * fbm(q.x * 0.21 + 11.0, q.y * 0.21, q.z * 0.21) + 0.45 * noise(q.x * 0.06, q.y * 0.06, q.z * 0.06 + 23.0);
     c = redden(c, al.mottling * (blood - 0.45));
+    // Pore-scale variation: follicles and the skin's microrelief darken
+    // and lighten it at under a millimetre (the renderer's albedo relief
+    // turns this into fine bumps too).
+    {
+        const glm::dvec3 f = q / al.pore_size;
+        const double grain = 0.6 * noise(f.x, f.y, f.z + 70.0) + 0.4 * noise(2.7 * f.x, 2.7 * f.y, 2.7 * f.z);
+        c = c * (1.0 + al.pore_strength * 2.0 * (grain - 0.5));
+    }
     const double ax = std::abs(q.x);
     // Forehead: a shade darker and more yellow.
     c = tint(c, al.forehead_tint, al.forehead_amount * glm::smoothstep(18.0, 45.0, q.y));
@@ -397,25 +411,18 @@ Texel Painter::skin(glm::dvec3 q) const {
         double flush = 0.0;
         for (const auto& f : al.flush)
             flush += f.amount * field(f.centre[0] == 0.0 ? q.x : ax, q.y, f.centre[0], f.centre[1], f.size[0], f.size[1]);
-        c = redden(c, flush * breakup * capillaries);
+        c = redden(c, flush * breakup * capillaries * (1.0 + 2.5 * half));
         // Freckles: one candidate per cell of a jittered grid, over the nose
         // and cheeks mostly.
         {
-            const double sp = al.freckle_spacing;
-            const int fx = static_cast<int>(std::floor(q.x / sp)), fy = static_cast<int>(std::floor(q.y / sp));
-            double spot = 0.0;
-            for (int dj = -1; dj <= 1; ++dj)
-                for (int di = -1; di <= 1; ++di) {
-                    const int i = fx + di, j = fy + dj;
-                    if (hash(i, j, 71) > 0.45) continue;
-                    const double px = (i + hash(i, j, 73)) * sp, py = (j + hash(i, j, 79)) * sp;
-                    const double r = al.freckle_size * (0.5 + hash(i, j, 83));
-                    spot = std::max(spot, (1.0 - glm::smoothstep(0.3 * r, r, std::hypot(q.x - px, q.y - py))) *
-                                              (0.4 + 0.6 * hash(i, j, 89)));
-                }
+            const double spot = spots(q.x, q.y, al.freckle_spacing, 0.45, al.freckle_size, 71);
             const double where = field(ax, q.y, 22.0, -30.0, 26.0, 16.0) + field(q.x, q.y, 0.0, -25.0, 10.0, 16.0);
-            c = blend(c, c * Rgb{0.86, 0.78, 0.72}, al.freckle_strength / 0.09 * 0.09 * 1.6 * spot * std::min(where, 1.0));
+            c = blend(c, c * Rgb{0.86, 0.78, 0.72}, al.freckle_strength * 1.6 * spot * std::min(where, 1.0));
         }
+        // Blemishes (small red spots: healing follicles, a broken capillary)
+        // and a few moles, anywhere on the face: skin is never clean.
+        c = redden(c, al.blemishes.strength * spots(q.x, q.y, al.blemishes.spacing, al.blemishes.chance, al.blemishes.size, 131));
+        c = blend(c, c * Rgb{0.62, 0.5, 0.44}, al.moles.strength * spots(q.x, q.y, al.moles.spacing, al.moles.chance, al.moles.size, 151));
         // Periorbital: thin skin, a warmer darker cast, deepest under the inner lower lid.
         const double eye_x = p_.eye_centre[0], eye_y = p_.eye_centre[1];
         const double orbit = field(ax, q.y, eye_x - 3.0, eye_y - 6.0, 11.0, 5.5) + 0.5 * field(ax, q.y, eye_x, eye_y + 3.0, 12.0, 6.0);
