@@ -447,7 +447,11 @@ void Generator::build_eyeball(Face& face, int side) {
     eb.pupil_angle = std::asin(p_.pupil_radius / R);
     eb.vertices.first = face.vertex_count();
     const VertexPart part = side == 0 ? VertexPart::EyeballLeft : VertexPart::EyeballRight;
+    // Both eyes share the eye tile in each eye's own frame (azimuth 0
+    // towards the outer corner): the right eye's azimuths are mirrored, so
+    // what the tile paints nasally (the caruncle) is nasal on both.
     auto uv = [&](double a, double b, double& u, double& v) {
+        if (side == 1) b = kPi - b;
         const double r = 0.48 * a / kPi;
         u = detail::tile_u0(detail::Tile::Eye) + detail::kTile * (0.5 + r * std::cos(b));
         v = detail::kTile * (0.5 + r * std::sin(b));
@@ -541,8 +545,9 @@ void Generator::build_lashes(Face& face, int side, bool upper) {
         if ((away.y > 0) != upper) away = away * -1.0;
         // Longest mid-lid, shortest at the inner end (FIDELITY.md).
         const double len = row.length * (0.45 + 0.55 * std::pow(std::sin(kPi * s), 0.6)) * (0.75 + 0.25 * s) *
-                           (0.85 + 0.3 * uniform());
-        const double lift = (row.lift_deg + 12.0 * (uniform() - 0.5)) * kDeg;
+                           (0.75 + 0.5 * uniform());
+        // Uneven lengths and directions: a comb of like lashes reads as a brush.
+        const double lift = (row.lift_deg + 18.0 * (uniform() - 0.5)) * kDeg;
         const double curl = row.curl_deg * (0.8 + 0.4 * uniform()) * kDeg;
         const double splay = 0.25 * (uniform() - 0.5) + 0.35 * (s - 0.5);  // outer lashes lean outwards
         glm::dvec3 p = root + radial * 0.3;  // from the lid's front edge

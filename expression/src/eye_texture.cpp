@@ -47,50 +47,88 @@ std::array<double, 3> eye_colour(const FaceShape& shape, double polar, double az
     const FaceParams& p = shape.params();
     const double R = p.eye_radius;
     const double ai = std::asin(p.iris_radius / R), ap = std::asin(p.pupil_radius / R);
-    // Frontal position on the eyeball at rest (mm from its centre).
+    // Frontal position on the eyeball at rest (mm from its centre; +x
+    // towards the outer corner, the tile being in each eye's own frame).
     const double x = R * std::sin(polar) * std::cos(azimuth), y = R * std::sin(polar) * std::sin(azimuth);
+    const double cx = p.eye_centre[0], cy = p.eye_centre[1];
 
-    // Sclera: the painted colour, greyer and pinker towards the corners,
-    // where it is exposed and its vessels show, darker round the back.
+    // Sclera: the painted colour, warmer and pinker towards the corners,
+    // where it is exposed and its vessels show, a faint cloudy unevenness
+    // (a flat white reads as glass), a grey-blue shade round the limbus,
+    // darker round the back.
     Rgb sclera = from255(p.sclera);
-    const double corner = glm::smoothstep(ai + 0.1, 1.25, polar) * std::pow(std::cos(azimuth), 2);
-    sclera = blend(sclera, tinted(sclera, {0.95, 0.82, 0.80}), p.sclera_corner_tint * corner);
+    const double mottle = 0.025 * std::sin(3.0 * azimuth + 5.0 * polar) + 0.02 * std::sin(7.0 * azimuth - 3.0 * polar + 1.0) +
+                          0.015 * std::sin(13.0 * azimuth + 11.0 * polar + 2.0);
+    sclera = tinted(sclera, {1.0 + mottle, 1.0 + 0.6 * mottle, 1.0 + 0.2 * mottle});
+    const double corner = glm::smoothstep(ai + 0.05, 1.2, polar) * std::pow(std::cos(azimuth), 2);
+    sclera = blend(sclera, tinted(sclera, {0.97, 0.80, 0.76}), std::min(1.0, 1.6 * p.sclera_corner_tint * corner));
+    const double limbal_shade = 1.0 - glm::smoothstep(ai, ai + 0.22, polar);
+    sclera = blend(sclera, tinted(sclera, {0.80, 0.84, 0.88}), 0.45 * limbal_shade);
     // Past about 100 degrees from the front pole the eyeball never shows
     // between the lids, whichever way it turns: no vessels there (they are
     // most of the eye tile's cost).
     const double shown = 1.0 - glm::smoothstep(1.6, 1.8, polar);
     if (shown > 0.0)
-        sclera = blend(sclera, tinted(sclera, {0.80, 0.30, 0.30}), p.sclera_vessels * shown * vessels(polar, azimuth, R, ai));
+        sclera = blend(sclera, tinted(sclera, {0.86, 0.36, 0.34}), p.sclera_vessels * shown * vessels(polar, azimuth, R, ai));
     sclera = scaled(sclera, 1.0 - 0.25 * glm::smoothstep(0.3 * kPi, 0.8 * kPi, polar));
 
-    Rgb c = sclera;
-    if (polar < ai + 0.03) {
-        // Iris: radial fibres (sums of sines in azimuth, bent a little as
-        // they run out), a warmer collarette round the pupil, darker crypts,
-        // and the limbal ring where the iris meets the sclera.
-        const double t = std::clamp((polar - ap) / (ai - ap), 0.0, 1.0);
-        const double bend = azimuth + 0.15 * t;
-        const double fibres = 0.5 + 0.22 * std::sin(61.0 * bend + 3.0 * std::sin(7.0 * bend)) +
-                              0.16 * std::sin(149.0 * bend + 5.0 * t) + 0.12 * std::sin(23.0 * bend - 2.0 * t);
-        Rgb iris = from255(p.iris);
-        iris = blend(iris, from255(p.iris_inner), 0.8 * (1.0 - glm::smoothstep(0.2, 0.45, t)));
-        iris = scaled(iris, 0.72 + 0.56 * fibres);
-        const double crypt = glm::smoothstep(0.6, 0.9, std::sin(19.0 * azimuth + 1.3) * std::sin(14.0 * t + 0.4));
-        iris = scaled(iris, 1.0 - 0.25 * crypt * glm::smoothstep(0.3, 0.45, t) * (1.0 - glm::smoothstep(0.7, 0.8, t)));
-        iris = scaled(iris, 1.0 - 0.6 * glm::smoothstep(0.78, 1.0, t));  // limbal ring
-        const Rgb pupil{0.015, 0.014, 0.016};
-        iris = blend(pupil, iris, glm::smoothstep(0.0, 0.05, t));
-        c = polar > ai ? blend(iris, sclera, (polar - ai) / 0.03) : iris;
+    // The caruncle and the plica semilunaris at the inner corner: the pink,
+    // moist mound where the lids meet nasally, and the fold of conjunctiva
+    // beside it (a white that runs into the corner reads as a doll's eye).
+    if (x < 0.0 && polar < 1.8) {
+        const double ax_corner = shape.eye.x_in;  // the inner corner (|x| of the face)
+        const double nasal = cx - ax_corner;      // mm from the eyeball's axis to the corner
+        const double slit = shape.eye.slit(cx + x) - cy;
+        const double dy = (y - slit) / 2.2;
+        const double across = std::exp(-dy * dy);
+        const double mound = glm::smoothstep(nasal - 5.5, nasal - 3.0, -x) * across;
+        const double lobules = 0.9 + 0.1 * std::sin(9.0 * y + 4.0 * x) * std::sin(7.0 * x - 3.0 * y);
+        sclera = blend(sclera, scaled(Rgb{0.80, 0.47, 0.44}, lobules), 0.85 * mound);
+        const double fold = (-x) - (nasal - 6.5);
+        const double plica = std::exp(-(fold / 0.6) * (fold / 0.6)) * across;
+        sclera = blend(sclera, tinted(sclera, {0.95, 0.74, 0.72}), 0.6 * plica);
     }
 
-    // The upper lid's shadow on the eyeball where it rests on it, and a
-    // fainter one under the lower lid: the lids stand off the eye by their
-    // thickness and the light comes from above.
-    // Both eyes share the tile, so the margins are those of the two sides averaged.
-    const double cx = p.eye_centre[0], cy = p.eye_centre[1];
-    const double upper_margin = 0.5 * (shape.eye.upper(cx + x) + shape.eye.upper(cx - x)) - cy;
-    const double lower_margin = 0.5 * (shape.eye.lower(cx + x) + shape.eye.lower(cx - x)) - cy;
-    const double shade = p.lid_shadow * glm::smoothstep(upper_margin - 3.0, upper_margin + 0.5, y) +
+    Rgb c = sclera;
+    constexpr double kLimbusSoftness = 0.06;  // radians over which the iris fades into the sclera
+    if (polar < ai + kLimbusSoftness) {
+        // Iris: bright radial fibres over darker gaps that wave a little as
+        // they run out, a jagged collarette a third of the way out with the
+        // warmer pupillary zone inside it, crypts beside it, faint
+        // contraction furrows round the outer part, the dark pupillary ruff,
+        // and the limbal ring where the iris meets the sclera.
+        const double t = std::clamp((polar - ap) / (ai - ap), 0.0, 1.0);
+        const double bend = azimuth + 0.12 * t + 0.03 * std::sin(9.0 * t + 3.0 * azimuth);
+        const double strands = 0.5 + 0.5 * std::sin(83.0 * bend + 2.5 * std::sin(11.0 * bend));
+        const double fibres = 0.45 * std::pow(strands, 3.0) + 0.25 * (0.5 + 0.5 * std::sin(151.0 * bend + 4.0 * t)) +
+                              0.3 * (0.5 + 0.5 * std::sin(37.0 * bend - 2.0 * t + 1.0));
+        const double collarette = 0.36 + 0.05 * std::sin(7.0 * azimuth + 0.5) + 0.03 * std::sin(17.0 * azimuth + 2.0);
+        Rgb iris = from255(p.iris);
+        iris = blend(iris, from255(p.iris_inner), 0.45 * (1.0 - glm::smoothstep(collarette - 0.1, collarette + 0.03, t)));
+        iris = scaled(iris, 0.62 + 0.7 * fibres);
+        // The collarette's ridge catches light.
+        const double ridge = std::exp(-std::pow((t - collarette) / 0.035, 2.0));
+        iris = blend(iris, tinted(from255(p.iris_inner), {1.2, 1.15, 1.1}), 0.25 * ridge);
+        const double crypt = glm::smoothstep(0.55, 0.95, std::sin(19.0 * azimuth + 1.3) * std::sin(23.0 * (t - collarette) + 0.4));
+        iris = scaled(iris, 1.0 - 0.35 * crypt * glm::smoothstep(collarette, collarette + 0.08, t) *
+                                 (1.0 - glm::smoothstep(0.7, 0.8, t)));
+        const double furrows = std::pow(0.5 + 0.5 * std::sin(kPi * 2.0 * (t - 0.62) / 0.09 + 0.4 * std::sin(5.0 * azimuth)), 6.0);
+        iris = scaled(iris, 1.0 - 0.18 * furrows * glm::smoothstep(0.6, 0.7, t) * (1.0 - glm::smoothstep(0.88, 0.92, t)));
+        iris = scaled(iris, 1.0 - 0.65 * glm::smoothstep(0.8, 1.0, t));  // limbal ring
+        iris = blend(Rgb{0.10, 0.06, 0.045}, iris, glm::smoothstep(0.02, 0.08, t));  // pupillary ruff
+        const Rgb pupil{0.012, 0.011, 0.013};
+        iris = blend(pupil, iris, glm::smoothstep(0.0, 0.025, t));
+        c = polar > ai ? blend(iris, sclera, glm::smoothstep(0.0, 1.0, (polar - ai) / kLimbusSoftness)) : iris;
+    }
+
+    // The upper lid's shadow on the eyeball where it rests on it, soft
+    // (the lid stands off the eye by its thickness, and the lashes and the
+    // lid's edge both shade it; the key light is above), and a fainter one
+    // under the lower lid.
+    const double upper_margin = shape.eye.upper(cx + x) - cy;
+    const double lower_margin = shape.eye.lower(cx + x) - cy;
+    const double from_upper = glm::smoothstep(upper_margin - 4.0, upper_margin + 0.5, y);
+    const double shade = p.lid_shadow * from_upper * (0.6 + 0.4 * from_upper) +
                          0.35 * p.lid_shadow * glm::smoothstep(lower_margin + 1.5, lower_margin - 0.5, y);
     // The corners are deeper in the socket.
     const double socket = 0.2 * glm::smoothstep(0.55 * R, 0.9 * R, std::abs(x));

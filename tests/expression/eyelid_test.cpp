@@ -190,5 +190,41 @@ TEST(Eyelids, EmotionsShowWhiteAboveTheIrisOnlyWhereTheirAusSaySo) {
     }
 }
 
+// As the lower margin rises (AU6, AU7) the skin below it bunches into a
+// bulge: the largest forward (z) motion of skin within 8 mm below the left
+// lower margin (mm). Lids that only rise or close (AU5, AU43) leave it.
+double lower_lid_bulge(const FapValues& faps) {
+    const Face& face = test_face();
+    const DeformedFace out = test_rig().deform(faps);
+    const Eyeball& eb = face.eyeballs.at(0);
+    std::vector<TriMesh::Point> rest(face.vertex_count());
+    for (int v = 0; v < face.vertex_count(); ++v) rest[v] = face.mesh.point(TriMesh::VertexHandle(v));
+    const double x_in = rest[eb.lower_margin.front()][0], x_out = rest[eb.lower_margin.back()][0];
+    double most = 0.0;
+    for (int v = 0; v < face.vertex_count(); ++v) {
+        if (face.parts[v] != VertexPart::Skin) continue;
+        const auto p = rest[v];
+        if (p[0] <= x_in + 2.0 || p[0] >= x_out - 2.0 || p[2] < eb.centre[2]) continue;
+        const double below = margin_y_at(eb.lower_margin, rest, p[0]) - p[1];
+        if (below > 0.5 && below < 8.0) most = std::max(most, double(out.positions[v][2] - p[2]));
+    }
+    return most;
+}
+
+TEST(Eyelids, TheSkinBelowARisingLowerLidBulges) {
+    struct Case {
+        int au;
+        double least, most;  // mm forward
+    };
+    const Case cases[] = {{6, 0.8, 3.0}, {7, 0.5, 3.0}, {5, -1.0, 0.2}, {43, -1.0, 0.2}};
+    for (const Case& c : cases) {
+        const double b = lower_lid_bulge(au_faps(c.au));
+        std::printf("AU%-3d lower-lid bulge %.2f mm\n", c.au, b);
+        SCOPED_TRACE(c.au);
+        EXPECT_GE(b, c.least);
+        EXPECT_LE(b, c.most);
+    }
+}
+
 }  // namespace
 }  // namespace emoface::expression
