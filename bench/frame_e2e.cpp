@@ -6,13 +6,16 @@
 // stage table (allocate, upload, per-frame morph, bump-mapped draw, whole
 // frame) as medians, and compares one frame with a reference render (the same
 // frame drawn on the CPU backend and llvmpipe, saved with --save), printing
-// the PSNR. Links neither OpenImageIO nor OpenCV, so it can be carried to the
+// the PSNR. Also the frame period in steady state with frames in flight
+// (throughput; --frames-in-flight 2: the pipelined GPU frame) beside the
+// single frame's latency (sample .. fence, nothing else in flight). Links neither OpenImageIO nor OpenCV, so it can be carried to the
 // GPU machine with its few libraries (frames are written as binary PPM).
 #include <epoxy/gl.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <cstdio>
 #include <fstream>
 #include <string>
@@ -93,7 +96,7 @@ int main(int argc, char** argv) {
     std::string data_dir = EMOFACE_DATA_DIR, fap_path, save, compare, backend_name = "auto";
     std::string frames_name = "mesh", accuracy = "exact", geometry = "auto";
     int frames = 500, warmup = 30, map_size = 2048, width = 1920, height = 1080, samples = 4;
-    int check_frame = 25;
+    int check_frame = 25, frames_in_flight = 1, ahead = 0;
     double face_scale = 1.0, min_psnr = 30.0;
     app.add_option("--data", data_dir, "the project's data folder");
     app.add_option("--fap", fap_path, "FAP file to play (default: data/fap/demo_tour.fap)");
@@ -117,6 +120,15 @@ int main(int argc, char** argv) {
         ->check(CLI::IsMember({"auto", "gpu", "cpu"}));
     app.add_option("--accuracy", accuracy, "morph accuracy: exact or fast")
         ->check(CLI::IsMember({"exact", "fast"}));
+    app.add_option("--frames-in-flight", frames_in_flight,
+                   "2: the pipelined GPU frame (frame n+1's morph and geometry beside frame n's draw; "
+                   "FaceSceneOptions::frames_in_flight)")
+        ->check(CLI::Range(1, 2));
+    app.add_option("--ahead", ahead,
+                   "throughput pass: frames the host may have submitted and not finished when it starts "
+                   "the next (0: it waits for each frame's fence first; on the H100 with interop, 1 or 2 cost "
+                   "~1.4 ms a frame more: docs/PERFORMANCE.md, fourth round)")
+        ->check(CLI::Range(0, 8));
     app.add_option("--check-frame", check_frame, "stream frame saved or compared");
     app.add_option("--save", save, "write the check frame as PPM (the reference, on the CPU)");
     app.add_option("--compare", compare, "PPM reference to compare the check frame with");
@@ -152,6 +164,7 @@ int main(int argc, char** argv) {
         so.geometry = geometry == "gpu"   ? render::GeometryDevice::Gpu
                       : geometry == "cpu" ? render::GeometryDevice::Cpu
                                           : render::GeometryDevice::Auto;
+        so.frames_in_flight = frames_in_flight;
         t = Clock::now();
         render::FaceScene scene(platform, face, *assets->rig, assets->keys, assets->lines, so);
         const double scene_ms = ms(Clock::now() - t);
@@ -176,6 +189,11 @@ int main(int argc, char** argv) {
                     face.mesh.n_vertices(), face.mesh.n_faces(), width, height, platform.samples(),
                     fap_path.c_str(), stream.frames.size(), stream.fps);
         std::printf("  setup: face, rig, profiles and keys %.0f ms, scene %.0f ms\n", assets_ms, scene_ms);
+        const bool pipelined = scene.frames_in_flight() == 2;
+        std::printf("  frames in flight: %d%s\n", scene.frames_in_flight(),
+                    pipelined ? " (pipelined: draw() draws the frame before the last update())"
+                    : frames_in_flight == 2 ? " (2 asked: needs the CUDA morph through interop and the GPU geometry)"
+                                            : "");
 
         render::DrawOptions draw;
         draw.camera = scene.frontal_camera(float(width) / float(height));
@@ -196,6 +214,7 @@ int main(int argc, char** argv) {
         if (!save.empty() || !compare.empty()) {
             const expression::FaceState st = state_of(frame_at(check_frame));
             scene.update(st.faps, render::key_weights(assets->keys, st));
+            scene.flush_pipeline();  // pipelined: the next draw() draws this frame
             platform.begin_frame();
             scene.draw(draw);
             platform.end_frame();
@@ -220,7 +239,43 @@ int main(int argc, char** argv) {
             }
         }
 
+        // Pass 0: throughput, frames in flight. The frame period in steady
+        // state: nothing waits for a frame but a limiter (before a frame the
+        // host waits until at most --ahead frames are unfinished); with 2
+        // frames in flight, frame n+1's morph and geometry are queued beside
+        // frame n's draw. Wall time over the timed frames / frames.
+        Series period_host;
+        double period_ms = 0;
+        {
+            std::deque<GLsync> queued;
+            auto start = Clock::now();
+            for (long i = 0; i < warmup + frames; ++i) {
+                while (queued.size() > std::size_t(ahead)) {
+                    glClientWaitSync(queued.front(), GL_SYNC_FLUSH_COMMANDS_BIT, GLuint64(10) * 1000000000ull);
+                    glDeleteSync(queued.front());
+                    queued.pop_front();
+                }
+                if (i == warmup) start = Clock::now();
+                const auto t0 = Clock::now();
+                const expression::FaceState st = state_of(frame_at(i));
+                scene.update(st.faps, render::key_weights(assets->keys, st));
+                platform.begin_frame();
+                scene.draw(draw);
+                platform.end_frame();
+                queued.push_back(glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0));
+                if (i >= warmup) period_host.add(ms(Clock::now() - t0));
+            }
+            for (GLsync f : queued) {
+                glClientWaitSync(f, GL_SYNC_FLUSH_COMMANDS_BIT, GLuint64(10) * 1000000000ull);
+                glDeleteSync(f);
+            }
+            period_ms = ms(Clock::now() - start) / double(frames);
+            scene.flush_pipeline();
+        }
+
         // Pass 1: whole frames, nothing but the final fence synchronises.
+        // Pipelined: the frame flushed before its draw, so this is one
+        // frame's latency with nothing else in flight.
         // The host's share: the frame's parameters (update) and everything
         // up to the draw's submission; the fence's wait is the GPU's.
         // With the GPU geometry, update()'s host stages too (FrameStageTimes).
@@ -231,6 +286,7 @@ int main(int argc, char** argv) {
             const std::vector<float> w = render::key_weights(assets->keys, st);
             const auto t1 = Clock::now();
             scene.update(st.faps, w);
+            scene.flush_pipeline();
             const auto t2 = Clock::now();
             platform.begin_frame();
             scene.draw(draw);
@@ -267,7 +323,8 @@ int main(int argc, char** argv) {
             cudaEventCreate(&ev3);
         }
 #endif
-        for (long i = 0; i < warmup + frames; ++i) {
+        // (update_geometry()/update_wrinkles(): not on a pipelined scene.)
+        for (long i = 0; i < (pipelined ? 0 : warmup + frames); ++i) {
             auto t0 = Clock::now();
             const expression::FaceState state = state_of(frame_at(i));
             const expression::FapValues& faps = state.faps;
@@ -341,7 +398,7 @@ int main(int argc, char** argv) {
         // weights), CUDA events around each frame's launches.
         Series morph_alone_s;
 #if EMOFACE_BENCH_CUDA
-        if (cuda) {
+        if (cuda && !pipelined) {
             void* stream_ptr = scene.morpher().cuda_stream();
             const auto s = static_cast<cudaStream_t>(stream_ptr);
             const morph::Layout target = scene.target_layout();
@@ -432,6 +489,15 @@ int main(int argc, char** argv) {
         row("draw (GL time, + MSAA resolve)", draw_s.median(), draw_s.pct(0.9));
         row("whole frame (sample .. fence)", whole.median(), whole.pct(0.9));
         std::printf("  whole frame - draw: %.3f ms (medians)\n", whole.median() - draw_s.median());
+        std::printf("\nthroughput: %d frame(s) in flight, the host at most %d frame(s) ahead (ms)\n",
+                    scene.frames_in_flight(), ahead);
+        std::printf("  %-44s %10.3f\n", "frame period in steady state (wall / frames)", period_ms);
+        if (!pipelined)
+            std::printf("  frame period - draw: %.3f ms\n", period_ms - draw_s.median());
+        else
+            std::printf("  (the draw alone is timed with --frames-in-flight 1: pass 2 needs update_geometry())\n");
+        row("host per frame (sample .. draw submitted)", period_host.median(), period_host.pct(0.9));
+        std::printf("  single frame, nothing else in flight: the whole frame above (sample .. fence)\n");
         std::printf("\nper-frame stages in detail (ms)\n");
         row("sample the FAP stream + face state (mix)", sample_s.median(), sample_s.pct(0.9));
         row(scene.uses_gpu_geometry() ? "geometry on the GPU: host (parameters, map, launch, unmap)"

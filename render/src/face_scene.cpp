@@ -72,6 +72,19 @@ std::vector<float> bake_occlusion(const expression::TriMesh& mesh) {
     return bake_vertex_occlusion(positions, normals, triangles);
 }
 
+// GL buffers of the sizes given (bytes), for CUDA to write and GL to copy from.
+std::vector<unsigned> gl_buffers_of(const std::vector<long long>& bytes) {
+    std::vector<unsigned> out(bytes.size());
+    if (out.empty()) return out;
+    glGenBuffers(GLsizei(out.size()), out.data());
+    for (std::size_t i = 0; i < out.size(); ++i) {
+        glBindBuffer(GL_COPY_WRITE_BUFFER, out[i]);
+        glBufferData(GL_COPY_WRITE_BUFFER, GLsizeiptr(bytes[i]), nullptr, GL_DYNAMIC_COPY);
+    }
+    glBindBuffer(GL_COPY_WRITE_BUFFER, 0);
+    return out;
+}
+
 }  // namespace
 
 const char* wrinkle_layout_name(WrinkleLayout layout) {
@@ -150,6 +163,8 @@ FaceScene::FaceScene(Platform& platform, const expression::Face& face,
     if (layout_kind_ == WrinkleLayout::Anchored && frames_ == WrinkleFrames::Shader)
         fail("render: FaceScene: WrinkleFrames::Shader has the projective layout's closed form; "
              "expected WrinkleFrames::Mesh with the anchored layout");
+    if (options.frames_in_flight != 1 && options.frames_in_flight != 2)
+        fail<InputError>("render: FaceScene: expected 1 or 2 frames in flight, found {}", options.frames_in_flight);
     if (keys.empty()) fail<InputError>("render: FaceScene: no wrinkle keys");
     if (lines_.empty()) fail<InputError>("render: FaceScene: no feature lines");
     if (face.parts.size() != face.mesh.n_vertices())
@@ -289,7 +304,27 @@ FaceScene::FaceScene(Platform& platform, const expression::Face& face,
         geometry_ = std::make_unique<FaceGeometry>(rig_, mesh_, std::move(geometry_parts),
                                                    std::array<float, 4>{box_.min.x, box_.min.y, box_.max.x, box_.max.y});
         cuda_geometry_ = std::make_unique<CudaGeometry>(*geometry_);
-        geometry_buffers_ = std::make_unique<GlBufferInterop>(buffers);
+        if (options.frames_in_flight == 2 && wrinkle_morph_->uses_interop()) {
+            // Pipelined: a second wrinkle texture, and two sets of buffers for
+            // the GPU geometry that draw() copies into the renderer's.
+            renderer_buffers_ = buffers;
+            for (unsigned b : buffers) {
+                GLint64 bytes = 0;
+                glBindBuffer(GL_COPY_READ_BUFFER, b);
+                glGetBufferParameteri64v(GL_COPY_READ_BUFFER, GL_BUFFER_SIZE, &bytes);
+                buffer_bytes_.push_back(bytes);
+            }
+            glBindBuffer(GL_COPY_READ_BUFFER, 0);
+            staging_ = gl_buffers_of(buffer_bytes_);
+            back_staging_ = gl_buffers_of(buffer_bytes_);
+            geometry_buffers_ = std::make_unique<GlBufferInterop>(staging_);
+            back_buffers_ = std::make_unique<GlBufferInterop>(back_staging_);
+            back_texture_ = std::make_unique<WrinkleTexture>(size_w, size_h, TexelFormat::RGBA8,
+                                                             NormalEncoding::Unsigned);
+            back_texture_->register_cuda();
+        } else {
+            geometry_buffers_ = std::make_unique<GlBufferInterop>(buffers);
+        }
     }
 
     // Start at the neutral pose with the first key alone.
@@ -297,11 +332,22 @@ FaceScene::FaceScene(Platform& platform, const expression::Face& face,
     std::vector<float> weights(keys.size(), 0.0f);
     weights[0] = 1.0f;
     update(neutral, weights);
+    flush_pipeline();
 }
 
 FaceScene::~FaceScene() {
     platform_.make_current();
+    if (pending_) {
+        try {
+            back_texture_->unmap(morpher_->cuda_stream(), back_buffers_->resources());
+        } catch (...) {  // a destructor must not throw
+        }
+    }
     geometry_buffers_.reset();
+    back_buffers_.reset();
+    for (std::vector<unsigned>* b : {&staging_, &back_staging_})
+        if (!b->empty()) glDeleteBuffers(GLsizei(b->size()), b->data());
+    back_texture_.reset();
     cuda_geometry_.reset();
     wrinkle_morph_.reset();
     texture_.reset();
@@ -342,26 +388,61 @@ void FaceScene::update_on_gpu(const expression::FapValues& faps, const std::vect
     }
     times_.layout_ms = ms_since(t);  // host time: the rig's parameters and the layout
     t = Clock::now();
+    // Pipelined, into the back set (a frame still in flight that no draw()
+    // took is handed over first: the newer one replaces it).
+    flush_pipeline();
+    WrinkleTexture& texture = back_texture_ ? *back_texture_ : *texture_;
+    GlBufferInterop& interop = back_texture_ ? *back_buffers_ : *geometry_buffers_;
     void* morph_stream = morpher_->cuda_stream();
-    const std::vector<void*>& buffers = geometry_buffers_->resources();
-    const unsigned long long surface = texture_->map_surface(morph_stream, buffers);
+    const std::vector<void*>& buffers = interop.resources();
+    const unsigned long long surface = texture.map_surface(morph_stream, buffers);
     try {
         cuda_geometry_->wait_for(morph_stream);
-        run_gpu_geometry(geometry_buffers_->pointers());
+        run_gpu_geometry(interop.pointers());
         times_.rig_ms = ms_since(t);  // host time: map, launches
         t = Clock::now();
         morpher_->morph_to_surface(target_, key_weights, params_, surface);
         cuda_geometry_->join_into(morph_stream);
     } catch (...) {
         try {
-            texture_->unmap(morph_stream, buffers);
+            texture.unmap(morph_stream, buffers);
         } catch (...) {  // the first error is the one to report
         }
         throw;
     }
-    texture_->unmap(morph_stream, buffers);
-    times_.morph_ms = ms_since(t);  // host time: the morph's launches, unmap
     times_.uv_ms = times_.tangents_ms = times_.upload_ms = 0.0;
+    if (back_texture_) {
+        // Unmapped by the next draw() after its own commands: the GL orders
+        // what follows an unmapping after the CUDA work before it, and what
+        // precedes it (that draw) is free to run beside that work.
+        pending_ = true;
+        times_.morph_ms = ms_since(t);  // host time: the morph's launches
+        return;
+    }
+    texture.unmap(morph_stream, buffers);
+    times_.morph_ms = ms_since(t);  // host time: the morph's launches, unmap
+}
+
+void FaceScene::flush_pipeline() {
+    if (!pending_) return;
+    platform_.make_current();
+    pending_ = false;
+    back_texture_->unmap(morpher_->cuda_stream(), back_buffers_->resources());
+    std::swap(texture_, back_texture_);
+    std::swap(geometry_buffers_, back_buffers_);
+    std::swap(staging_, back_staging_);
+    staging_copied_ = false;
+}
+
+void FaceScene::copy_staging_to_renderer() {
+    for (std::size_t i = 0; i < staging_.size(); ++i) {
+        glBindBuffer(GL_COPY_READ_BUFFER, staging_[i]);
+        glBindBuffer(GL_COPY_WRITE_BUFFER, renderer_buffers_[i]);
+        glCopyBufferSubData(GL_COPY_READ_BUFFER, GL_COPY_WRITE_BUFFER, 0, 0, GLsizeiptr(buffer_bytes_[i]));
+    }
+    glBindBuffer(GL_COPY_READ_BUFFER, 0);
+    glBindBuffer(GL_COPY_WRITE_BUFFER, 0);
+    staging_copied_ = true;
 }
 
 void FaceScene::run_gpu_geometry(const std::vector<float*>& buffers) {
@@ -375,6 +456,9 @@ void FaceScene::run_gpu_geometry(const std::vector<float*>& buffers) {
 }
 
 void FaceScene::update_wrinkles(const std::vector<float>& key_weights) {
+    if (back_texture_)
+        fail("render: FaceScene::update_wrinkles(): expected a scene with 1 frame in flight, found 2 "
+             "(the pipelined frame is made by update() alone)");
     platform_.make_current();
     const auto t = Clock::now();
     wrinkle_morph_->update(target_, key_weights, params_);
@@ -382,6 +466,9 @@ void FaceScene::update_wrinkles(const std::vector<float>& key_weights) {
 }
 
 void FaceScene::update_geometry(const expression::FapValues& faps) {
+    if (back_texture_)
+        fail("render: FaceScene::update_geometry(): expected a scene with 1 frame in flight, found 2 "
+             "(the pipelined frame is made by update() alone)");
     deform(faps, /*layout_from_mesh=*/true);
 }
 
@@ -480,14 +567,19 @@ void FaceScene::finish() {
 }
 
 void FaceScene::draw(const DrawOptions& options) {
+    if (back_texture_) {
+        platform_.make_current();
+        if (!staging_copied_) copy_staging_to_renderer();
+    }
     if (frames_ == WrinkleFrames::Shader) {
         DrawOptions o = options;
         o.projective_wrinkles = true;
         o.projective_box = {box_.min.x, box_.min.y, box_.max.x, box_.max.y};
         renderer_->draw(o, texture_.get());
-        return;
+    } else {
+        renderer_->draw(options, texture_.get());
     }
-    renderer_->draw(options, texture_.get());
+    flush_pipeline();  // the frame in flight, after this draw's commands
 }
 
 Camera FaceScene::frontal_camera(float aspect, float fovy_degrees) const {

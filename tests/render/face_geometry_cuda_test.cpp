@@ -164,5 +164,63 @@ TEST(FaceSceneGeometry, OneMappingDrawsWhatTheCpuDraws) {
     }
 }
 
+// frames_in_flight 2: update() leaves its frame in flight into the second
+// texture and buffers and draw() draws the frame before it, which the CPU
+// scene draws too, frame after frame (a wrong order between the CUDA work,
+// the unmapping after the draw and the swap would draw the frame in flight,
+// a stale one or half-written buffers); flush_pipeline() lands the last.
+TEST(FaceSceneGeometry, PipelinedDrawsWhatTheCpuDrawsAFrameLater) {
+    if (!cuda_geometry_available()) GTEST_SKIP() << "no CUDA device: the GPU geometry is not tested here";
+    FaceAssetsOptions ao;
+    ao.face.resolution_scale = 0.5;
+    ao.face.texture_size = 256;
+    ao.wrinkle_map_size = 256;
+    const auto assets = load_default_face_assets(EMOFACE_DATA_DIR, ao);
+    PlatformOptions po;
+    po.width = po.height = 160;
+    po.cuda_device = 0;
+    HeadlessPlatform platform(po);
+    FaceSceneOptions gpu_options;
+    gpu_options.backend = morph::Backend::Cuda;
+    gpu_options.frames_in_flight = 2;
+    const auto gpu = make_face_scene(platform, *assets, gpu_options);
+    if (!gpu->uses_interop()) GTEST_SKIP() << "the GL context is not on the CUDA device: no interop";
+    ASSERT_EQ(gpu->frames_in_flight(), 2);
+    FaceSceneOptions cpu_options;
+    cpu_options.backend = morph::Backend::Cpu;
+    cpu_options.frames_in_flight = 2;  // no CUDA: the scene runs unpipelined
+    const auto cpu = make_face_scene(platform, *assets, cpu_options);
+    ASSERT_EQ(cpu->frames_in_flight(), 1);
+
+    DrawOptions draw;
+    draw.camera = cpu->frontal_camera(1.0f);
+    draw.light = cpu->portrait_light();
+    draw.shading = Shading::Thesis;
+    auto render = [&](FaceScene& scene) {
+        platform.begin_frame();
+        scene.draw(draw);
+        platform.end_frame();
+        return platform.read_rgba();
+    };
+    const std::vector<float> weights(std::size_t(gpu->key_count()), 1.0f / float(gpu->key_count()));
+    // Frame 0 draws the scene's first state (neutral, the first key alone).
+    ImageRGBA8 previous;
+    int compared = 0;
+    for (const NamedFaps& named : frames()) {
+        gpu->update(named.faps, weights);
+        const ImageRGBA8 g = render(*gpu);
+        const ImageRGBA8 c = render(*cpu);  // the CPU scene still at the frame before
+        EXPECT_GE(diff_images(g, c).psnr(), 40.0) << "the frame before " << named.name;
+        if (!previous.pixels.empty() && compared > 1)
+            EXPECT_LT(diff_images(g, previous).psnr(), 60.0) << "the frame before " << named.name << " did not change";
+        previous = g;
+        cpu->update(named.faps, weights);
+        ++compared;
+    }
+    gpu->flush_pipeline();
+    EXPECT_GE(diff_images(render(*gpu), render(*cpu)).psnr(), 40.0) << "the last frame, flushed";
+    EXPECT_GT(compared, 2);
+}
+
 }  // namespace
 }  // namespace emoface::render

@@ -113,6 +113,14 @@ struct FaceSceneOptions {
     // morph runs on CUDA through interop (so the GL context is on a CUDA
     // device), else the CPU.
     GeometryDevice geometry = GeometryDevice::Auto;
+    // 2: the pipelined GPU frame. update() leaves its frame in flight (the
+    // morph and the geometry queued on CUDA into a second wrinkle texture and
+    // second vertex buffers) and draw() draws the frame before it, so the
+    // GPU computes frame n+1 while it draws frame n, ordered on the GPU only.
+    // Needs the CUDA morph through interop and the GPU geometry; otherwise
+    // the scene runs as with 1 (frames_in_flight() says which). With 2,
+    // update() alone makes frames (update_geometry()/update_wrinkles() refuse).
+    int frames_in_flight = 1;
     FaceSceneOptions();
 };
 
@@ -151,7 +159,14 @@ public:
     void update_wrinkles(const std::vector<float>& key_weights);
 
     // Draws the three meshes (options.wrinkles false: without the wrinkle map).
+    // With frames_in_flight() 2: the frame of the update() before the last
+    // one (the last one's is in flight), which it then hands to the next draw.
     void draw(const DrawOptions& options);
+    // 1, or 2 when the frame is pipelined (FaceSceneOptions::frames_in_flight).
+    int frames_in_flight() const { return back_texture_ ? 2 : 1; }
+    // Pipelined: the frame in flight becomes the one draw() draws (as after
+    // a draw()); the next draw() then draws the last update(). Else nothing.
+    void flush_pipeline();
     // Waits until the GL has done all it was given (glFinish): the draw's
     // rasterisation (on llvmpipe, the CPU's threads) and, through interop,
     // the CUDA morph the draw waits for. A clock read after it bills the
@@ -200,6 +215,9 @@ private:
     void update_on_gpu(const expression::FapValues& faps, const std::vector<float>& key_weights);
     // CudaGeometry::run into the mapped vertex buffers (GlBufferInterop's order).
     void run_gpu_geometry(const std::vector<float*>& buffers);
+    // Pipelined: the GPU geometry's buffers (staging_, as the renderer's
+    // buffers_ in order) copied into the renderer's, in the GL's order.
+    void copy_staging_to_renderer();
 
     Platform& platform_;
     const expression::Face& face_;
@@ -223,6 +241,17 @@ private:
     std::unique_ptr<FaceGeometry> geometry_;
     std::unique_ptr<CudaGeometry> cuda_geometry_;
     std::unique_ptr<GlBufferInterop> geometry_buffers_;
+    // Pipelined (frames_in_flight 2): texture_ and geometry_buffers_ (over
+    // staging_) hold the frame draw() draws, the back_ ones the frame in
+    // flight (mapped for CUDA while pending_); a frame handed over swaps them.
+    // The GPU geometry writes GL buffers of its own (staging_) that draw()
+    // copies into the renderer's (renderer_buffers_), as the renderer's
+    // meshes have one set of vertex buffers.
+    std::unique_ptr<WrinkleTexture> back_texture_;
+    std::unique_ptr<GlBufferInterop> back_buffers_;
+    std::vector<unsigned> staging_, back_staging_, renderer_buffers_;
+    std::vector<long long> buffer_bytes_;
+    bool pending_ = false, staging_copied_ = false;
 };
 
 }  // namespace emoface::render
