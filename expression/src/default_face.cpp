@@ -989,7 +989,7 @@ void Generator::place_feature_points(Face& face) {
                 int best = 0;
                 double best_d = std::numeric_limits<double>::max();
                 for (int v = 0; v < skin_end; ++v) {
-                    const auto q = face.mesh.point(TriMesh::VertexHandle(v));
+                    const glm::dvec3 q = symmetric(v);
                     if (q[0] * side < 40.0) continue;
                     const double d = std::hypot(q[1] - yz[0], q[2] - yz[1]);
                     if (d < best_d) {
