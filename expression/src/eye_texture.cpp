@@ -61,7 +61,7 @@ std::array<double, 3> eye_colour(const FaceShape& shape, double polar, double az
                           0.015 * std::sin(13.0 * azimuth + 11.0 * polar + 2.0);
     sclera = tinted(sclera, {1.0 + mottle, 1.0 + 0.6 * mottle, 1.0 + 0.2 * mottle});
     const double corner = glm::smoothstep(ai + 0.05, 1.2, polar) * std::pow(std::cos(azimuth), 2);
-    sclera = blend(sclera, tinted(sclera, {0.97, 0.80, 0.76}), std::min(1.0, 1.6 * p.sclera_corner_tint * corner));
+    sclera = blend(sclera, tinted(sclera, {0.97, 0.80, 0.76}), std::min(1.0, 2.0 * p.sclera_corner_tint * corner));
     const double limbal_shade = 1.0 - glm::smoothstep(ai, ai + 0.22, polar);
     sclera = blend(sclera, tinted(sclera, {0.80, 0.84, 0.88}), 0.45 * limbal_shade);
     // Past about 100 degrees from the front pole the eyeball never shows
@@ -131,7 +131,7 @@ std::array<double, 3> eye_colour(const FaceShape& shape, double polar, double az
     const double shade = p.lid_shadow * from_upper * (0.6 + 0.4 * from_upper) +
                          0.35 * p.lid_shadow * glm::smoothstep(lower_margin + 1.5, lower_margin - 0.5, y);
     // The corners are deeper in the socket.
-    const double socket = 0.2 * glm::smoothstep(0.55 * R, 0.9 * R, std::abs(x));
+    const double socket = 0.3 * glm::smoothstep(0.45 * R, 0.9 * R, std::abs(x));
     return scaled(c, (1.0 - std::min(shade, 0.8)) * (1.0 - socket));
 }
 
