@@ -508,7 +508,7 @@ void FaceRig::build_jaw(const Face& face) {
             // Fully on the jaw (lower lip) or off it (upper) only mid-mouth:
             // towards the corners both lips follow it partly, so an open
             // mouth is an oval narrowing into closed corners, not a slot.
-            const double lip = 1.0 - glm::smoothstep(0.3 * half_width, 1.1 * half_width, std::abs(x - mx));
+            const double lip = 1.0 - glm::smoothstep(0.15 * half_width, 1.15 * half_width, std::abs(x - mx));
             w = to_lower[v] < to_upper[v] ? std::max(w, lip) : std::min(w, 1.0 - lip);
         }
         // The neck below the chin and the head behind the jaw joint stay; the

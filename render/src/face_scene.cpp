@@ -10,7 +10,7 @@
 
 #include "emoface/common/error.h"
 #include "emoface/common/timing.h"
-#include "emoface/render/ambient_occlusion.h"
+#include "emoface/render/face_occlusion.h"
 #include "emoface/render/face_geometry.h"
 #include "emoface/render/tangents.h"
 #include "emoface/render/wrinkle_morph.h"
@@ -50,26 +50,6 @@ morph::Layout to_morph_layout(const std::vector<expression::Segment>& segments) 
     out.reserve(segments.size());
     for (const auto& s : segments) out.push_back({s.p.x, s.p.y, s.q.x, s.q.y});
     return out;
-}
-
-std::vector<float> bake_occlusion(const expression::TriMesh& mesh) {
-    std::vector<glm::vec3> positions(mesh.n_vertices()), normals(mesh.n_vertices());
-    for (const auto vh : mesh.vertices()) {
-        const auto& p = mesh.point(vh);
-        const auto& n = mesh.normal(vh);
-        positions[std::size_t(vh.idx())] = {p[0], p[1], p[2]};
-        normals[std::size_t(vh.idx())] = {n[0], n[1], n[2]};
-    }
-    std::vector<unsigned> triangles;
-    triangles.reserve(mesh.n_faces() * 3);
-    for (const auto fh : mesh.faces()) {
-        unsigned v[3];
-        int k = 0;
-        for (const auto vh : mesh.fv_range(fh))
-            if (k < 3) v[k++] = unsigned(vh.idx());
-        if (k == 3) triangles.insert(triangles.end(), v, v + 3);
-    }
-    return bake_vertex_occlusion(positions, normals, triangles);
 }
 
 // GL buffers of the sizes given (bytes), for CUDA to write and GL to copy from.
@@ -234,10 +214,10 @@ FaceScene::FaceScene(Platform& platform, const expression::Face& face,
         }
         part.mesh.add_face(h[0], h[1], h[2]);
     }
-    // Ambient occlusion of the rest shape, the whole head occluding: the
-    // skin takes it (the eyeballs turn and the mouth opens away from the
-    // rest shape's occluders, so they keep their own shading).
-    const std::vector<float> occlusion = bake_occlusion(mesh_);
+    // Ambient occlusion of the rest shape (face_occlusion.h): the skin and the
+    // mouth interior take it (the eyeballs turn away from the rest shape's
+    // occluders, so they keep their own shading).
+    const std::vector<float> occlusion = bake_face_occlusion(mesh_, face);
     const Material* materials[kGroups] = {&options.skin, &options.eyes, &options.mouth};
     for (int g = 0; g < kGroups; ++g) {
         Part& part = parts_[g];
@@ -270,7 +250,7 @@ FaceScene::FaceScene(Platform& platform, const expression::Face& face,
             }
         part.fixed_tangents.assign(part.full_index.size(), glm::vec4(1, 0, 0, 1));
         part.id = renderer_->add_mesh(part.mesh, m);
-        if (g == kSkin) {
+        if (g != kEyes) {
             std::vector<float> part_occlusion(part.full_index.size());
             for (std::size_t i = 0; i < part.full_index.size(); ++i)
                 part_occlusion[i] = occlusion[std::size_t(part.full_index[i])];

@@ -339,6 +339,10 @@ vec3 shade_skin(vec3 n_bumped, vec3 n_geo, vec3 base, float cavity, float gloss,
     // by the environment BRDF towards the reflection, both occluded.
     color += hemisphere(s.n_r) * s.diffuse_albedo * (s.cavity * s.dim_shadow);
     color += hemisphere(reflect(-s.v, s.n)) * sheen * s.dim_sheen;
+    // The mouth interior's baked occlusion (face_occlusion.h) stands for the
+    // lips and cheeks over an open mouth: they shade it from every light
+    // (the eyes have none: 1).
+    if (!u_skin_surface) color *= v_occlusion;
     return color;
 }
 

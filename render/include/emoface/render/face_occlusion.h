@@ -1,0 +1,28 @@
+#pragma once
+// The baked ambient occlusion of a face's rest shape (ambient_occlusion.h),
+// aware that the mouth opens away from it. Three bakes:
+// - the skin, the whole head occluding;
+// - the lips (around the mouth slit, from the inner lip contour out past the
+//   vermilion borders, found from feature points 2.2-2.5, 8.1 and 8.2): at
+//   rest each lip hides the other's inner face, which would show dark when
+//   the mouth opens; they are baked again without the lips and the mouth
+//   interior among the occluders (the nose, cheeks and chin stay), and the
+//   brighter of the two fades in over the lips;
+// - the mouth interior (cavity, teeth, gums, tongue: the non-skin, non-eye
+//   parts), which the skin bake sees only through the closed slit: baked on
+//   its own at a finer texel (its cavity shades its back, the teeth each
+//   other), then dimmed with the depth behind where the lips meet, standing
+//   for the lips and cheeks over an open mouth.
+// Eyeball vertices get the whole-head bake (the renderer leaves them open).
+#include <vector>
+
+#include "emoface/expression/face.h"
+
+namespace emoface::render {
+
+// One value per vertex of `mesh` in [0, 1], 1 = open. `mesh` is the face's
+// mesh with vertex normals; a face without parts or lip feature points gets
+// the plain whole-mesh bake.
+std::vector<float> bake_face_occlusion(const expression::TriMesh& mesh, const expression::Face& face);
+
+}  // namespace emoface::render
