@@ -588,9 +588,11 @@ void Generator::build_mouth_interior(Face& face) {
         const int rings = 10, segs = 36;
         auto part_of = [&](double y) { return y >= cc.y ? VertexPart::MouthUpper : VertexPart::MouthLower; };
         auto uv = [&](double g, double s, double& u, double& v) {
-            // Most of the cavity maps near the tile's dark centre: the mouth's
-            // inside is dark but where the lips' light reaches in.
-            const double rr = 0.48 * std::pow(g / (0.5 * kPi), 3.0);
+            // The cavity's mucosa is a dark red throughout (the tile's rim);
+            // its darkening with depth is the renderer's occlusion, baked for
+            // the interior (face_scene.cpp bake_occlusion), so it lightens
+            // where the lips part instead of staying black.
+            const double rr = 0.48 * (0.8 + 0.2 * g / (0.5 * kPi));
             u = detail::tile_u0(Tile::Cavity) + detail::kTile * (0.5 + rr * std::cos(s));
             v = detail::kTile * (0.5 + rr * std::sin(s));
         };
@@ -630,7 +632,10 @@ void Generator::build_mouth_interior(Face& face) {
     const double z_front = stomion[2] - p_.teeth_gap;  // labial face of the upper incisors
     auto arch = [&](bool upper) {
         const double sign = upper ? 1.0 : -1.0;  // from the biting edge towards the root
-        const double y_edge = upper ? p_.mouth_y - 1.0 : p_.mouth_y + 0.6;
+        // The upper incisors' edge shows 2-3 mm below the relaxed upper lip
+        // (incisal display at rest); the lower incisors' edge rises about 2 mm
+        // behind it (overbite), hidden by the lower lip until the jaw drops.
+        const double y_edge = upper ? p_.mouth_y - 2.5 : p_.mouth_y - 0.5;
         const double W = upper ? p_.teeth_half_width : p_.teeth_half_width - 2.0;
         const double D = upper ? p_.teeth_depth : p_.teeth_depth - 1.5;
         const double z0 = upper ? z_front : z_front - 2.2;  // lower incisors sit behind the upper ones
