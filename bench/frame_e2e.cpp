@@ -420,7 +420,7 @@ int main(int argc, char** argv) {
         // Pass 3 (GPU geometry): the kernels alone, into device memory of
         // their own (no interop), the rig alone and rig + parts, CUDA events
         // around each launch pair.
-        Series rig_alone_s, kernels_alone_s;
+        Series rig_alone_s, kernels_alone_s, probe_draw_s, probe_kernels_s, probe_both_s;
 #if EMOFACE_BENCH_CUDA
         if (scene.geometry()) {
             render::FaceGeometry rig_only(*assets->rig, face.mesh, {},
@@ -458,6 +458,41 @@ int main(int argc, char** argv) {
                 if (i < warmup) continue;
                 rig_alone_s.add(r_ms);
                 kernels_alone_s.add(k_ms);
+            }
+            // Pass 3b: do CUDA kernels and the GL draw run at once? The
+            // geometry's kernels (into device memory, no interop, nothing
+            // shared with the draw) launched kProbe times, the draw, both:
+            // wall time to both done. At once: both ~ max(draw, kernels);
+            // one after the other: ~ their sum.
+            constexpr int kProbe = 20;
+            const expression::RigFrame probe_frame = assets->rig->frame(state_of(frame_at(check_frame)).faps);
+            auto kernels = [&] {
+                for (int k = 0; k < kProbe; ++k) all_gpu.run(probe_frame, shape_d, frame_d);
+            };
+            auto drawn = [&] {
+                platform.begin_frame();
+                scene.draw(draw);
+                platform.end_frame();
+            };
+            for (long i = 0; i < warmup + std::min(frames, 100); ++i) {
+                auto t0 = Clock::now();
+                drawn();
+                fence();
+                const double d = ms(Clock::now() - t0);
+                t0 = Clock::now();
+                kernels();
+                all_gpu.finish();
+                const double k = ms(Clock::now() - t0);
+                t0 = Clock::now();
+                kernels();
+                drawn();
+                fence();
+                all_gpu.finish();
+                const double b = ms(Clock::now() - t0);
+                if (i < warmup) continue;
+                probe_draw_s.add(d);
+                probe_kernels_s.add(k);
+                probe_both_s.add(b);
             }
             cudaEventDestroy(a0);
             cudaEventDestroy(a1);
@@ -498,6 +533,15 @@ int main(int argc, char** argv) {
             std::printf("  (the draw alone is timed with --frames-in-flight 1: pass 2 needs update_geometry())\n");
         row("host per frame (sample .. draw submitted)", period_host.median(), period_host.pct(0.9));
         std::printf("  single frame, nothing else in flight: the whole frame above (sample .. fence)\n");
+        if (!probe_both_s.v.empty()) {
+            std::printf("\nCUDA kernels beside the GL draw? (wall ms to done; no interop between them)\n");
+            row("draw alone", probe_draw_s.median(), probe_draw_s.pct(0.9));
+            row("geometry kernels x20 alone", probe_kernels_s.median(), probe_kernels_s.pct(0.9));
+            row("both, the kernels queued first", probe_both_s.median(), probe_both_s.pct(0.9));
+            std::printf("  both - max(alone): %.3f ms; both - sum: %.3f ms (near 0: one after the other)\n",
+                        probe_both_s.median() - std::max(probe_draw_s.median(), probe_kernels_s.median()),
+                        probe_both_s.median() - probe_draw_s.median() - probe_kernels_s.median());
+        }
         std::printf("\nper-frame stages in detail (ms)\n");
         row("sample the FAP stream + face state (mix)", sample_s.median(), sample_s.pct(0.9));
         row(scene.uses_gpu_geometry() ? "geometry on the GPU: host (parameters, map, launch, unmap)"
