@@ -244,7 +244,7 @@ void resolve_strokes(const std::vector<WrinkleSpec>& specs, const FoldShape& sha
         // A valley with its shoulders on the wide flank reaches this far.
         const float wide = 1.0f + shape.asymmetry;
         const float reach = std::max(spec.profile == WrinkleProfile::Fold
-                                         ? 6.0f * wide * sigma
+                                         ? 8.5f * sigma
                                          : (shape.shoulder_offset + 3.0f * shape.shoulder_width) * wide * sigma,
                                      3.0f * shape.wall_width * wide * sigma);
         if (curve.size() == 1) {  // a round mark: no along-the-fold shape
@@ -355,8 +355,8 @@ float stroke_height(const Stroke& s, const FoldShape& shape, float unit, glm::ve
         case WrinkleProfile::Bulge:
             return depth * bump(best, sigma);
         case WrinkleProfile::Fold:
-            // The cheek bulges over the `side` flank; the other keeps a small shoulder.
-            return depth * (-valley + 0.5f * bump(s.side * signed_best - 2.0f * sigma, 1.5f * sigma) +
+            // The cheek rounds broadly over the `side` flank; the other keeps a small shoulder.
+            return depth * (-valley + 0.55f * bump(s.side * signed_best - 2.5f * sigma, 2.0f * sigma) +
                             0.5f * shape.shoulder *
                                 bump(-s.side * signed_best - shape.shoulder_offset * flank,
                                      shape.shoulder_width * flank));
@@ -560,6 +560,7 @@ WrinkleLibrarySpec load_wrinkle_spec(const std::string& path) {
             c.comment("why");
             spec.cavity.full_depth = read_number(c, "full_depth", spec.cavity.full_depth, 1e-4f, 1.0f);
             spec.cavity.darkest = read_number(c, "darkest", spec.cavity.darkest, 0.0f, 1.0f);
+            spec.cavity.radius = read_number(c, "radius", spec.cavity.radius, 1e-3f, 0.5f);
             c.finish();
         }
         if (root.has("neutral_skin_detail")) {
@@ -641,10 +642,32 @@ std::vector<float> render_height_field(const WrinkleLibrarySpec& spec, const Wri
     return height;
 }
 
+namespace {
+
+// Box-filters `line` (n values, `stride` apart) in place, `passes` times,
+// each a running mean over 2 r + 1 values with the ends held: three passes
+// are close to a Gaussian of sigma r.
+void box_blur_line(float* line, int n, int stride, int r, int passes, std::vector<float>& scratch) {
+    scratch.resize(static_cast<size_t>(n));
+    const float inv = 1.0f / static_cast<float>(2 * r + 1);
+    for (int pass = 0; pass < passes; ++pass) {
+        for (int i = 0; i < n; ++i) scratch[i] = line[static_cast<size_t>(i) * stride];
+        const auto at = [&](int i) { return scratch[std::clamp(i, 0, n - 1)]; };
+        float sum = 0.0f;
+        for (int i = -r; i <= r; ++i) sum += at(i);
+        for (int i = 0; i < n; ++i) {
+            line[static_cast<size_t>(i) * stride] = sum * inv;
+            sum += at(i + r + 1) - at(i - r);
+        }
+    }
+}
+
+}  // namespace
+
 NormalMap height_to_normal_map(const std::vector<float>& height, int size, float face_unit,
                                const CavitySpec& cavity, const WrinkleRegion& region) {
-    // Heights and positions share normalised units; the cavity's full depth
-    // is in face units.
+    // Heights and positions share normalised units; the cavity's lengths
+    // are in face units.
     const float full_depth = cavity.full_depth * face_unit;
     NormalMap map;
     map.width = map.height = size;
@@ -669,6 +692,27 @@ NormalMap height_to_normal_map(const std::vector<float>& height, int size, float
     const auto encode = [](float v) {
         return static_cast<std::uint8_t>(std::clamp(std::lround((0.5f + 0.5f * v) * 255.0f), 0L, 255L));
     };
+    // The skin around each point (a Gaussian of sigma cavity.radius): how far
+    // a valley floor lies below it is how enclosed it is. A narrow crease
+    // is nearly as deep below its surroundings as it is deep, and dark; a
+    // broad shallow fold of the same depth lies in its own walls, and stays
+    // open. Over the region and the blur's reach beyond it (zero heights).
+    const int blur = std::max(1, static_cast<int>(std::lround(cavity.radius * face_unit * size)));
+    const int w0 = std::max(0, c0 - 3 * blur), w1 = std::min(size - 1, c1 + 3 * blur);
+    const int h0 = std::max(0, r0 - 3 * blur), h1 = std::min(size - 1, r1 + 3 * blur);
+    const int ww = w1 - w0 + 1, wh = h1 - h0 + 1;
+    std::vector<float> around(static_cast<size_t>(ww) * wh);
+    for (int r = h0; r <= h1; ++r)
+        std::memcpy(&around[static_cast<size_t>(r - h0) * ww], &height[static_cast<size_t>(r) * size + w0],
+                    sizeof(float) * static_cast<size_t>(ww));
+    parallel_for(wh, 16, [&](int begin, int end) {
+        std::vector<float> scratch;
+        for (int r = begin; r < end; ++r) box_blur_line(&around[static_cast<size_t>(r) * ww], ww, 1, blur, 3, scratch);
+    });
+    parallel_for(ww, 16, [&](int begin, int end) {
+        std::vector<float> scratch;
+        for (int c = begin; c < end; ++c) box_blur_line(&around[static_cast<size_t>(c)], wh, ww, blur, 3, scratch);
+    });
     for_each_row_band(r1 - r0 + 1, [&](int band_row) {
         const int r = r0 + band_row;
         for (int c = c0; c <= c1; ++c) {
@@ -679,10 +723,16 @@ NormalMap height_to_normal_map(const std::vector<float>& height, int size, float
             px[0] = encode(-dx / len);
             px[1] = encode(-dy / len);
             px[2] = encode(1.0f / len);
-            // The cavity: a valley occludes light in proportion to its depth.
+            // The cavity: only valleys occlude, by how far they lie below
+            // the skin around them.
             const float h = height[static_cast<size_t>(r) * size + c];
-            const float occlusion = h < 0.0f ? std::min(-h / full_depth, 1.0f) : 0.0f;
-            px[3] = h < 0.0f ? encode(2.0f * (1.0f - (1.0f - cavity.darkest) * occlusion) - 1.0f) : 255;
+            if (h >= 0.0f) {
+                px[3] = 255;
+                continue;
+            }
+            const float below = around[static_cast<size_t>(r - h0) * ww + (c - w0)] - h;
+            const float occlusion = std::clamp(below / full_depth, 0.0f, 1.0f);
+            px[3] = encode(2.0f * (1.0f - (1.0f - cavity.darkest) * occlusion) - 1.0f);
         }
     });
     return map;

@@ -81,10 +81,13 @@ struct FoldShape {
 };
 
 // Cavity (ambient occlusion of a valley) stored in a map's alpha: 1 on open
-// skin and on raised skin, falling in valleys.
+// skin and on raised skin, falling in valleys by how far the valley floor
+// lies below the skin around it (the height field's Gaussian mean of sigma
+// `radius`): narrow creases darken, broad shallow folds barely.
 struct CavitySpec {
-    float full_depth = 0.025f;  // face units: a valley this deep gets the darkest cavity
+    float full_depth = 0.025f;  // face units: a floor this far below its surroundings gets the darkest cavity
     float darkest = 0.35f;      // alpha at or below full_depth
+    float radius = 0.04f;       // face units: the surroundings' sigma
 };
 
 struct SkinDetail {
@@ -155,7 +158,7 @@ std::vector<float> render_height_field(const WrinkleLibrarySpec& spec, const Wri
 // Tangent-space normal map of a height field (see the convention above),
 // with the cavity in alpha: exactly 255 where the height is >= 0, lower in
 // valleys (heights in normalised texture units; face_unit scales
-// cavity.full_depth to them). Where the height field is locally flat the
+// cavity.full_depth and cavity.radius to them). Where the height field is locally flat the
 // pixel is exactly (128, 128, 255, 255), and outside `region` (where the
 // height must be 0) it is written so without looking.
 NormalMap height_to_normal_map(const std::vector<float>& height, int size, float face_unit,
