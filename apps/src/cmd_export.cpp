@@ -43,7 +43,12 @@
 
 #include "cli_checks.h"
 #include "command.h"
+#include "gltf_buffers.h"
+#include "gltf_correctives.h"
+#include "gltf_parts.h"
+#include "gltf_wrinkles.h"
 #include "emoface/common/error.h"
+#include "emoface/common/parallel.h"
 #include "emoface/expression/capture.h"
 #include "emoface/expression/default_face.h"
 #include "emoface/expression/face_io.h"
@@ -57,11 +62,14 @@ namespace {
 namespace ex = emoface::expression;
 using emoface::InputError;
 using emoface::fail;
+namespace gltf = emoface::apps::gltf;
 
 struct ExportArgs {
     std::string out, face = "default", fdp, animation, mix, data = EMOFACE_DATA_DIR;
     double face_resolution = 1.0;
     double fap_step = 0;  // 0: per FAP, from its range
+    int wrinkle_size = 512;
+    bool no_wrinkles = false;
 };
 
 bool ends_with(const std::string& s, const std::string& e) {
@@ -90,95 +98,6 @@ ex::Face load_face(const ExportArgs& a) {
     fail<InputError>("export: --face {}: expected default, FILE.wfm or FILE.obj", a.face);
 }
 
-// Appends `bytes` to buffer 0 (4-byte aligned) as a buffer view; its index.
-int add_view(tinygltf::Model& m, const void* bytes, std::size_t size, int target = 0) {
-    auto& buf = m.buffers[0].data;
-    while (buf.size() % 4) buf.push_back(0);
-    tinygltf::BufferView v;
-    v.buffer = 0;
-    v.byteOffset = buf.size();
-    v.byteLength = size;
-    if (target) v.target = target;
-    buf.insert(buf.end(), static_cast<const unsigned char*>(bytes), static_cast<const unsigned char*>(bytes) + size);
-    m.bufferViews.push_back(v);
-    return static_cast<int>(m.bufferViews.size()) - 1;
-}
-
-int add_accessor(tinygltf::Model& m, const std::vector<float>& data, int type, int components, bool bounds,
-                 int target = TINYGLTF_TARGET_ARRAY_BUFFER) {
-    tinygltf::Accessor acc;
-    acc.bufferView = add_view(m, data.data(), data.size() * sizeof(float), target);
-    acc.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
-    acc.type = type;
-    acc.count = data.size() / components;
-    if (bounds) {
-        acc.minValues.assign(components, 1e30);
-        acc.maxValues.assign(components, -1e30);
-        for (std::size_t i = 0; i < data.size(); ++i) {
-            const int c = static_cast<int>(i % components);
-            // glTF bounds are the float values themselves.
-            acc.minValues[c] = std::min(acc.minValues[c], static_cast<double>(data[i]));
-            acc.maxValues[c] = std::max(acc.maxValues[c], static_cast<double>(data[i]));
-        }
-    }
-    m.accessors.push_back(acc);
-    return static_cast<int>(m.accessors.size()) - 1;
-}
-
-// Minimal zlib-free PNG: stored (uncompressed) deflate blocks, so the base
-// colour travels without another library (viewers decode it as any PNG).
-std::vector<unsigned char> encode_png(const ex::Image& img) {
-    auto crc32 = [](const unsigned char* p, std::size_t n, std::uint32_t c = 0xffffffffu) {
-        for (std::size_t i = 0; i < n; ++i) {
-            c ^= p[i];
-            for (int k = 0; k < 8; ++k) c = (c >> 1) ^ (0xedb88320u & (0u - (c & 1u)));
-        }
-        return c;
-    };
-    std::vector<unsigned char> raw;
-    const std::size_t row = static_cast<std::size_t>(img.width) * 4;
-    for (int y = 0; y < img.height; ++y) {
-        raw.push_back(0);
-        raw.insert(raw.end(), img.rgba.begin() + y * row, img.rgba.begin() + (y + 1) * row);
-    }
-    std::vector<unsigned char> z{0x78, 0x01};
-    std::uint32_t a = 1, b = 0;
-    for (unsigned char c : raw) {
-        a = (a + c) % 65521;
-        b = (b + a) % 65521;
-    }
-    for (std::size_t i = 0; i < raw.size() || i == 0; i += 65535) {
-        const std::size_t n = std::min<std::size_t>(65535, raw.size() - i);
-        z.push_back(i + n >= raw.size() ? 1 : 0);
-        z.push_back(n & 0xff);
-        z.push_back(n >> 8);
-        z.push_back(~n & 0xff);
-        z.push_back((~n >> 8) & 0xff);
-        z.insert(z.end(), raw.begin() + i, raw.begin() + i + n);
-        if (raw.empty()) break;
-    }
-    const std::uint32_t adler = (b << 16) | a;
-    for (int s = 24; s >= 0; s -= 8) z.push_back((adler >> s) & 0xff);
-    std::vector<unsigned char> png{0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-    auto chunk = [&](const char* type, const std::vector<unsigned char>& data) {
-        const std::uint32_t n = static_cast<std::uint32_t>(data.size());
-        for (int s = 24; s >= 0; s -= 8) png.push_back((n >> s) & 0xff);
-        std::vector<unsigned char> td(type, type + 4);
-        td.insert(td.end(), data.begin(), data.end());
-        png.insert(png.end(), td.begin(), td.end());
-        const std::uint32_t c = ~crc32(td.data(), td.size());
-        for (int s = 24; s >= 0; s -= 8) png.push_back((c >> s) & 0xff);
-    };
-    std::vector<unsigned char> ihdr;
-    for (std::uint32_t v : {static_cast<std::uint32_t>(img.width), static_cast<std::uint32_t>(img.height)})
-        for (int s = 24; s >= 0; s -= 8) ihdr.push_back((v >> s) & 0xff);
-    ihdr.insert(ihdr.end(), {8, 6, 0, 0, 0});
-    chunk("IHDR", ihdr);
-    chunk("IDAT", z);
-    chunk("IEND", {});
-    return png;
-}
-
 // The reference value of FAP n for its target: the larger end of its range
 // (a value the face shows), 200 units where the range is unbounded.
 double fap_scale(const ex::FapRanges& r, int n, double step) {
@@ -187,17 +106,28 @@ double fap_scale(const ex::FapRanges& r, int n, double step) {
     return std::isfinite(s) && s > 0 ? s : 200.0;
 }
 
+// The correctives' aim: every vertex of every exported pose within this many
+// ES0 of the rig (issue 14 asks 0.02), at most kMaxCorrectives of them; the
+// vertices never further off than kCorrectiveNegligible ES0 are left out.
+constexpr double kCorrectiveTolerance = 0.004;
+constexpr double kCorrectiveNegligible = 0.0004;
+constexpr int kMaxCorrectives = 128;
+
 void export_gltf(const ExportArgs& a) {
     if (!ends_with(a.out, ".glb")) fail<InputError>("export: --out {}: expected a file ending in .glb", a.out);
     if (!a.animation.empty() && !a.mix.empty())
         fail<InputError>("export: give an animation file or --mix, not both");
     emoface::apps::check_in_range("export", "--face-resolution", a.face_resolution, 0.1, 2.0);
+    emoface::apps::check_in_range("export", "--wrinkle-size", a.wrinkle_size, 256, 4096);
+    const bool wrinkles = !a.no_wrinkles && gltf::wrinkles_available();
     emoface::apps::OutputFile out(a.out, "export", "--out");
 
     const ex::Face face = load_face(a);
     ex::RigOptions ro;
     ro.ranges = ex::load_fap_ranges(a.data + "/expression/fap_ranges.json");
-    const ex::FaceRig rig(face, ro);
+    // Owned, so the wrinkle key maker can borrow it.
+    auto rig_owner = std::make_unique<ex::FaceRig>(face, ro);
+    const ex::FaceRig& rig = *rig_owner;
     const auto emotions = ex::load_emotion_profiles(a.data + "/expression/emotions.json");
     const auto visemes = ex::load_viseme_profiles(a.data + "/expression/visemes.json");
     const ex::ArkitShapes arkit =
@@ -205,17 +135,23 @@ void export_gltf(const ExportArgs& a) {
 
     // The animation (or mix) first: a bad file fails before the slow targets.
     std::vector<ex::FapValues> frames;
+    std::vector<ex::FaceState> states;
     std::vector<double> times;
     if (!a.animation.empty()) {
         const ex::Animation anim = ex::read_animation_file(a.animation, a.data);
         if (anim.stream.frames.empty()) fail<InputError>("export: {}: the file has no frames", a.animation);
         for (std::size_t k = 0; k < anim.stream.frames.size(); ++k) {
-            frames.push_back(ex::face_state(anim.stream.resolved(k), emotions, &visemes).faps);
+            states.push_back(ex::face_state(anim.stream.resolved(k), emotions, &visemes));
+            frames.push_back(states.back().faps);
             times.push_back(anim.stream.frame_time(k));
         }
     }
     ex::FapValues still{};
-    if (!a.mix.empty()) still = ex::face_state(ex::parse_emotion_mix(a.mix), emotions).faps;
+    ex::FaceState still_state;
+    if (!a.mix.empty()) {
+        still_state = ex::face_state(ex::parse_emotion_mix(a.mix), emotions);
+        still = still_state.faps;
+    }
 
     const int nv = face.vertex_count();
     const ex::RigView view = rig.view();
@@ -237,10 +173,12 @@ void export_gltf(const ExportArgs& a) {
             std::fill(std::begin(e.t), std::end(e.t), 0.0);
         }
         p.resize(3 * nv);
-        for (int v = 0; v < nv; ++v) {
-            const auto q = ex::rig_kernel::position(view, f, v);
-            p[3 * v] = q.x, p[3 * v + 1] = q.y, p[3 * v + 2] = q.z;
-        }
+        emoface::parallel_for(nv, 4096, [&](int begin, int end) {
+            for (int v = begin; v < end; ++v) {
+                const auto q = ex::rig_kernel::position(view, f, v);
+                p[3 * v] = q.x, p[3 * v + 1] = q.y, p[3 * v + 2] = q.z;
+            }
+        });
     };
 
     // Composite targets: their profile's FAPs. Each is the sum of its FAPs'
@@ -326,6 +264,66 @@ void export_gltf(const ExportArgs& a) {
         return w;
     };
 
+    // Correctives: what the FAP targets leave of the rig's motion at the
+    // exported poses (gltf_correctives.h says what and why), so that the
+    // file reproduces the rig at every frame.
+    const std::vector<ex::FapValues> poses = frames.empty() ? std::vector<ex::FapValues>{still} : frames;
+    gltf::Correctives correctives;
+    {
+        struct Moved {
+            int v;
+            float d[3];
+        };
+        std::vector<std::vector<Moved>> moved(fap_targets);
+        for (std::size_t t = 0; t < fap_targets; ++t)
+            for (int v = 0; v < nv; ++v) {
+                const float* d = &deltas[t][3 * v];
+                if (d[0] != 0 || d[1] != 0 || d[2] != 0) moved[t].push_back({v, {d[0], d[1], d[2]}});
+            }
+        // A vertex off by less than this in every pose is left as it is.
+        const float negligible = static_cast<float>(kCorrectiveNegligible * es0);
+        std::vector<std::vector<std::pair<int, std::array<float, 3>>>> off(poses.size());
+        std::vector<char> active(nv, 0);
+        std::vector<float> exact;
+        for (std::size_t k = 0; k < poses.size(); ++k) {
+            morph_stage(poses[k], exact);
+            for (int i = 0; i < 3 * nv; ++i) exact[i] -= base[i];
+            const std::vector<float> w = weights_of(poses[k]);
+            for (std::size_t t = 0; t < fap_targets; ++t)
+                if (w[t] != 0)
+                    for (const Moved& mv : moved[t])
+                        for (int c = 0; c < 3; ++c) exact[3 * mv.v + c] -= w[t] * mv.d[c];
+            for (int v = 0; v < nv; ++v) {
+                const float* r = &exact[3 * v];
+                if (std::max({std::abs(r[0]), std::abs(r[1]), std::abs(r[2])}) <= negligible) continue;
+                off[k].push_back({v, {r[0], r[1], r[2]}});
+                active[v] = 1;
+            }
+        }
+        std::vector<int> vertices, row_of(nv, -1);
+        for (int v = 0; v < nv; ++v)
+            if (active[v]) row_of[v] = static_cast<int>(vertices.size()), vertices.push_back(v);
+        std::vector<std::vector<float>> remainders(poses.size(), std::vector<float>(3 * vertices.size(), 0.0f));
+        for (std::size_t k = 0; k < poses.size(); ++k) {
+            for (const auto& [v, r] : off[k]) std::copy(r.begin(), r.end(), &remainders[k][3 * row_of[v]]);
+            std::vector<std::pair<int, std::array<float, 3>>>().swap(off[k]);
+        }
+        correctives = gltf::fit_correctives(vertices, std::move(remainders), nv, kCorrectiveTolerance * es0,
+                                            kMaxCorrectives);
+    }
+    const std::size_t first_corrective = names.size();
+    for (std::size_t c = 0; c < correctives.targets.size(); ++c) {
+        names.push_back(fmt::format("corrective_{}", c + 1));
+        deltas.push_back(std::move(correctives.targets[c]));
+    }
+    // A pose's weights: its FAPs' and its correctives'.
+    auto pose_weights = [&](std::size_t k) {
+        std::vector<float> w = weights_of(poses[k]);
+        const std::vector<float>& c = correctives.weights[k];
+        std::copy(c.begin(), c.end(), w.begin() + first_corrective);
+        return w;
+    };
+
     tinygltf::Model m;
     m.asset.version = "2.0";
     m.asset.generator = "emoface export";
@@ -333,7 +331,7 @@ void export_gltf(const ExportArgs& a) {
 
     tinygltf::Primitive prim;
     prim.mode = TINYGLTF_MODE_TRIANGLES;
-    prim.attributes["POSITION"] = add_accessor(m, base, TINYGLTF_TYPE_VEC3, 3, true);
+    prim.attributes["POSITION"] = gltf::add_floats(m, base, TINYGLTF_TYPE_VEC3, 3, true);
     {
         ex::TriMesh mesh = face.mesh;
         mesh.request_face_normals();
@@ -345,7 +343,7 @@ void export_gltf(const ExportArgs& a) {
             const float len = std::sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
             for (int c = 0; c < 3; ++c) n[3 * v + c] = len > 0 ? nn[c] / len : (c == 2 ? 1.0f : 0.0f);
         }
-        prim.attributes["NORMAL"] = add_accessor(m, n, TINYGLTF_TYPE_VEC3, 3, false);
+        prim.attributes["NORMAL"] = gltf::add_floats(m, n, TINYGLTF_TYPE_VEC3, 3, false);
         if (face.mesh.has_vertex_texcoords2D()) {
             std::vector<float> uv(2 * nv);
             for (int v = 0; v < nv; ++v) {
@@ -353,23 +351,28 @@ void export_gltf(const ExportArgs& a) {
                 uv[2 * v] = t[0];
                 uv[2 * v + 1] = 1.0f - t[1];  // glTF's v runs down the image
             }
-            prim.attributes["TEXCOORD_0"] = add_accessor(m, uv, TINYGLTF_TYPE_VEC2, 2, false);
+            prim.attributes["TEXCOORD_0"] = gltf::add_floats(m, uv, TINYGLTF_TYPE_VEC2, 2, false);
         }
-        std::vector<std::uint32_t> idx;
-        for (auto f : face.mesh.faces())
-            for (auto v : face.mesh.fv_range(f)) idx.push_back(static_cast<std::uint32_t>(v.idx()));
-        tinygltf::Accessor acc;
-        acc.bufferView = add_view(m, idx.data(), idx.size() * 4, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
-        acc.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
-        acc.type = TINYGLTF_TYPE_SCALAR;
-        acc.count = idx.size();
-        m.accessors.push_back(acc);
-        prim.indices = static_cast<int>(m.accessors.size()) - 1;
+        if (wrinkles) {
+            // The wrinkle maps' UV set: the neutral face projected frontally
+            // into its texture box (v down, as glTF's).
+            std::vector<float> uv(2 * nv);
+            for (int v = 0; v < nv; ++v) {
+                const glm::vec2 t = ex::project_to_texture(glm::vec3(base[3 * v], base[3 * v + 1], base[3 * v + 2]),
+                                                           face.texture_box);
+                uv[2 * v] = t.x;
+                uv[2 * v + 1] = t.y;
+            }
+            prim.attributes["TEXCOORD_1"] = gltf::add_floats(m, uv, TINYGLTF_TYPE_VEC2, 2, false);
+            // The skin's normal texture is sampled in this set: its tangents.
+            prim.attributes["TANGENT"] =
+                gltf::add_floats(m, gltf::wrinkle_tangents(mesh, uv), TINYGLTF_TYPE_VEC4, 4, false);
+        }
     }
-    for (const auto& d : deltas) {
-        std::vector<float> f(d.begin(), d.end());
-        prim.targets.push_back({{"POSITION", add_accessor(m, f, TINYGLTF_TYPE_VEC3, 3, true)}});
-    }
+    // Sparse: a target stores only the vertices it moves (most move a small
+    // region), anything under a millionth of ES0 counted as unmoved.
+    for (const auto& d : deltas)
+        prim.targets.push_back({{"POSITION", gltf::add_sparse_vec3(m, d, static_cast<float>(1e-6 * es0))}});
 
     // Skinning: the rig blends the jaw and the head into each vertex with its
     // own weight (rig_kernel.h blend_rigid: p + w (M p - p)), which is linear
@@ -400,40 +403,54 @@ void export_gltf(const ExportArgs& a) {
         for (int i = 0; i < 4 * nv; ++i)
             if (jw[i] == 0.0f) joints[i] = 0;
         tinygltf::Accessor acc;
-        acc.bufferView = add_view(m, joints.data(), joints.size() * 2, TINYGLTF_TARGET_ARRAY_BUFFER);
+        acc.bufferView = gltf::add_view(m, joints.data(), joints.size() * 2, TINYGLTF_TARGET_ARRAY_BUFFER);
         acc.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
         acc.type = TINYGLTF_TYPE_VEC4;
         acc.count = nv;
         m.accessors.push_back(acc);
         prim.attributes["JOINTS_0"] = static_cast<int>(m.accessors.size()) - 1;
-        prim.attributes["WEIGHTS_0"] = add_accessor(m, jw, TINYGLTF_TYPE_VEC4, 4, false);
+        prim.attributes["WEIGHTS_0"] = gltf::add_floats(m, jw, TINYGLTF_TYPE_VEC4, 4, false);
     }
 
-    tinygltf::Material mat;
-    mat.name = "face";
-    mat.pbrMetallicRoughness.metallicFactor = 0.0;
-    mat.pbrMetallicRoughness.roughnessFactor = 0.6;
-    mat.doubleSided = true;
-    if (!face.base_colour.empty() && prim.attributes.count("TEXCOORD_0")) {
-        const std::vector<unsigned char> png = encode_png(face.base_colour);
-        tinygltf::Image img;
-        img.name = "base_colour";
-        img.mimeType = "image/png";
-        img.bufferView = add_view(m, png.data(), png.size());
-        m.images.push_back(img);
-        tinygltf::Texture tex;
-        tex.source = 0;
-        m.textures.push_back(tex);
-        mat.pbrMetallicRoughness.baseColorTexture.index = 0;
+    // The wrinkle keys (textures; layouts and AU targets in extras).
+    gltf::WrinkleExport wrinkle_keys;
+    if (wrinkles) {
+        std::vector<ex::FaceState> exported = states;
+        if (exported.empty()) exported.push_back(still_state);
+        wrinkle_keys = gltf::add_wrinkle_keys(m, face, rig_owner, emotions, a.data, a.wrinkle_size, names, exported);
     }
-    m.materials.push_back(mat);
-    prim.material = 0;
 
+    // One material per part, sharing the base colour; one primitive each,
+    // sharing the vertices and targets.
+    int base_colour = -1;
+    if (!face.base_colour.empty() && prim.attributes.count("TEXCOORD_0"))
+        base_colour = gltf::add_texture(m, gltf::add_png(m, "base_colour", face.base_colour.width,
+                                                         face.base_colour.height, face.base_colour.rgba.data()));
     tinygltf::Mesh mesh;
+    for (const gltf::PartMaterial& part : gltf::split_into_parts(face, view)) {
+        tinygltf::Material mat;
+        mat.name = part.name;
+        mat.pbrMetallicRoughness.metallicFactor = 0.0;
+        mat.pbrMetallicRoughness.roughnessFactor = part.roughness;
+        mat.doubleSided = true;
+        if (base_colour >= 0) mat.pbrMetallicRoughness.baseColorTexture.index = base_colour;
+        if (part.name == "skin" && wrinkle_keys.neutral_texture >= 0) {
+            mat.normalTexture.index = wrinkle_keys.neutral_texture;
+            mat.normalTexture.texCoord = 1;
+        }
+        tinygltf::Value::Object me;
+        me["roughness"] = tinygltf::Value(std::string(part.why));
+        mat.extras = tinygltf::Value(me);
+        m.materials.push_back(mat);
+        tinygltf::Primitive p = prim;
+        p.indices = gltf::add_indices(m, part.triangles, nv);
+        p.material = static_cast<int>(m.materials.size()) - 1;
+        mesh.primitives.push_back(p);
+    }
+
     mesh.name = face.name.empty() ? "face" : face.name;
-    mesh.primitives.push_back(prim);
     {
-        const std::vector<float> w = weights_of(still);
+        const std::vector<float> w = frames.empty() ? pose_weights(0) : weights_of(still);
         mesh.weights.assign(w.begin(), w.end());
         tinygltf::Value::Array tn, sc;
         for (const auto& n : names) tn.emplace_back(n);
@@ -445,7 +462,10 @@ void export_gltf(const ExportArgs& a) {
         extras["fapScale"] = tinygltf::Value(fs);
         extras["about"] = tinygltf::Value(std::string(
             "FAPnn_* targets: the rig's motion at FAP value fapScale[n] (weight = FAP value / fapScale); AU, emotion, "
-            "viseme and ARKit targets are sums of the FAP targets with their profile's values"));
+            "viseme and ARKit targets are sums of the FAP targets with their profile's values; corrective_* "
+            "targets carry what the FAP targets leave of the rig's motion at the exported frames (the lids' slide "
+            "over the eyeballs, the lashes' turn, the pupils' dilation), weighted by the animation"));
+        if (wrinkles) extras["wrinkles"] = wrinkle_keys.extras;
         mesh.extras = tinygltf::Value(extras);
     }
     m.meshes.push_back(mesh);
@@ -498,7 +518,7 @@ void export_gltf(const ExportArgs& a) {
         return p;
     };
     // Each moving joint's pose in a frame; the head's copies share them.
-    auto poses = [&](const ex::FapValues& faps) {
+    auto joint_poses = [&](const ex::FapValues& faps) {
         const ex::RigFrame f = rig.frame(faps);
         std::vector<Pose> p(joint_nodes.size());
         p[j_jaw] = p[j_head_jaw] = rigid(f.jaw, f.jaw_r, f.jaw_pivot, f.jaw_t);
@@ -508,7 +528,7 @@ void export_gltf(const ExportArgs& a) {
         return p;
     };
     {
-        const std::vector<Pose> rest = poses(still);
+        const std::vector<Pose> rest = joint_poses(still);
         for (std::size_t j = 1; j < joint_nodes.size(); ++j) {
             auto& n = m.nodes[joint_nodes[j]];
             n.rotation = {rest[j].r.x, rest[j].r.y, rest[j].r.z, rest[j].r.w};
@@ -521,9 +541,9 @@ void export_gltf(const ExportArgs& a) {
         std::vector<std::vector<float>> rot(joint_nodes.size()), tra(joint_nodes.size());
         for (std::size_t k = 0; k < frames.size(); ++k) {
             t.push_back(static_cast<float>(times[k]));
-            const std::vector<float> wk = weights_of(frames[k]);
+            const std::vector<float> wk = pose_weights(k);
             w.insert(w.end(), wk.begin(), wk.end());
-            const std::vector<Pose> pk = poses(frames[k]);
+            const std::vector<Pose> pk = joint_poses(frames[k]);
             for (std::size_t j = 1; j < joint_nodes.size(); ++j) {
                 rot[j].insert(rot[j].end(), {float(pk[j].r.x), float(pk[j].r.y), float(pk[j].r.z), float(pk[j].r.w)});
                 tra[j].insert(tra[j].end(), {float(pk[j].t.x), float(pk[j].t.y), float(pk[j].t.z)});
@@ -531,7 +551,7 @@ void export_gltf(const ExportArgs& a) {
         }
         tinygltf::Animation anim;
         anim.name = std::filesystem::path(a.animation).filename().string();
-        const int input = add_accessor(m, t, TINYGLTF_TYPE_SCALAR, 1, true, 0);
+        const int input = gltf::add_floats(m, t, TINYGLTF_TYPE_SCALAR, 1, true, 0);
         auto channel = [&](int output, int node, const std::string& path) {
             tinygltf::AnimationSampler s;
             s.input = input;
@@ -544,10 +564,23 @@ void export_gltf(const ExportArgs& a) {
             ch.target_path = path;
             anim.channels.push_back(ch);
         };
-        channel(add_accessor(m, w, TINYGLTF_TYPE_SCALAR, 1, false, 0), n_mesh, "weights");
+        channel(gltf::add_floats(m, w, TINYGLTF_TYPE_SCALAR, 1, false, 0), n_mesh, "weights");
         for (std::size_t j = 1; j < joint_nodes.size(); ++j) {
-            channel(add_accessor(m, rot[j], TINYGLTF_TYPE_VEC4, 4, false, 0), joint_nodes[j], "rotation");
-            channel(add_accessor(m, tra[j], TINYGLTF_TYPE_VEC3, 3, false, 0), joint_nodes[j], "translation");
+            channel(gltf::add_floats(m, rot[j], TINYGLTF_TYPE_VEC4, 4, false, 0), joint_nodes[j], "rotation");
+            channel(gltf::add_floats(m, tra[j], TINYGLTF_TYPE_VEC3, 3, false, 0), joint_nodes[j], "translation");
+        }
+        if (!wrinkle_keys.key_names.empty()) {
+            // glTF animates no extras: the wrinkle keys' weights per frame
+            // (frame-major, keys in wrinkles.keys' order) for an engine to
+            // play alongside.
+            std::vector<float> kw;
+            for (const auto& fw : wrinkle_keys.frame_weights) kw.insert(kw.end(), fw.begin(), fw.end());
+            tinygltf::Value::Object ae;
+            ae["wrinkleWeights"] = tinygltf::Value(gltf::add_floats(m, kw, TINYGLTF_TYPE_SCALAR, 1, false, 0));
+            tinygltf::Value::Array kn;
+            for (const auto& n : wrinkle_keys.key_names) kn.emplace_back(n);
+            ae["wrinkleKeys"] = tinygltf::Value(kn);
+            anim.extras = tinygltf::Value(ae);
         }
         m.animations.push_back(anim);
     }
@@ -558,9 +591,11 @@ void export_gltf(const ExportArgs& a) {
     if (!writer.WriteGltfSceneToFile(&m, out.path(), true, true, false, true))
         fail<emoface::InputError>("export: cannot write {}", a.out);
     out.commit();
-    fmt::print("{} -> {} ({} vertices, {} morph targets ({} FAPs), {} animation frames)\n",
+    fmt::print("{} -> {} ({} vertices, {} morph targets ({} FAPs, {} correctives: worst vertex {:.4f} ES0 off the "
+               "rig before skinning), {} wrinkle keys, {} animation frames)\n",
                a.animation.empty() ? (a.mix.empty() ? "neutral" : a.mix) : a.animation, a.out, nv, names.size(),
-               fap_targets, frames.size());
+               fap_targets, names.size() - first_corrective, correctives.worst_left / es0,
+               wrinkle_keys.key_names.size(), frames.size());
 }
 
 void add_export_command(CLI::App& root) {
@@ -568,13 +603,16 @@ void add_export_command(CLI::App& root) {
     auto* sub = root.add_subcommand(
         "export", "Write the face as glTF 2.0 (.glb) with morph targets (FAPs, AUs, emotions, visemes, ARKit shapes) "
                   "and an animation file's frames as a glTF animation");
-    sub->add_option("animation", a->animation, "Animation file (FAP, OpenFace or ARKit CSV) to export as an animation");
+    sub->add_option("animation", a->animation, "Animation file (FAP, or an OpenFace, Live Link Face or MediaPipe CSV) to export as an animation");
     sub->add_option("--out", a->out, "The .glb file to write")->required();
     sub->add_option("--face", a->face, "default, FILE.wfm (Candide-3) or FILE.obj (with --fdp)")->capture_default_str();
     sub->add_option("--fdp", a->fdp, "Feature points of an .obj face");
     sub->add_option("--mix", a->mix, "A still expression, e.g. \"0.7 joy + 0.3 AU4\": the mesh's default weights");
     sub->add_option("--face-resolution", a->face_resolution, "The default face's mesh resolution (0.1..2)")
         ->capture_default_str();
+    sub->add_option("--wrinkle-size", a->wrinkle_size, "Side of the wrinkle key maps in pixels (256..4096)")
+        ->capture_default_str();
+    sub->add_flag("--no-wrinkles", a->no_wrinkles, "Leave the wrinkle key maps out");
     sub->add_option("--data", a->data, "The project's data folder")->capture_default_str();
     sub->callback([a] { export_gltf(*a); });
 }

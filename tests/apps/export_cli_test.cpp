@@ -10,6 +10,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -27,6 +29,7 @@
 #include "emoface/expression/face_state.h"
 #include "emoface/expression/profiles.h"
 #include "emoface/expression/rig.h"
+#include "emoface/expression/wrinkle_map.h"
 #include "support/run_emoface.h"
 #include "support/scratch_dir.h"
 
@@ -42,12 +45,33 @@ const std::string kRealFap = std::string(EMOFACE_REALDATA_DIR) + "/fap";
 // A coarser mesh keeps the test fast; the rig and the export are the same code at any resolution.
 const std::string kResolution = "0.5";
 
+// A float accessor's values, dense or sparse (zeros, or its buffer view,
+// with the sparse entries written over them).
 std::vector<float> floats(const tinygltf::Model& m, int accessor) {
     const tinygltf::Accessor& a = m.accessors.at(accessor);
-    const tinygltf::BufferView& v = m.bufferViews.at(a.bufferView);
     const int comps = a.type == TINYGLTF_TYPE_VEC4 ? 4 : a.type == TINYGLTF_TYPE_VEC3 ? 3 : a.type == TINYGLTF_TYPE_VEC2 ? 2 : 1;
-    std::vector<float> out(a.count * comps);
-    std::memcpy(out.data(), m.buffers.at(v.buffer).data.data() + v.byteOffset + a.byteOffset, out.size() * 4);
+    std::vector<float> out(a.count * comps, 0.0f);
+    auto bytes = [&](int view, std::size_t offset) {
+        const tinygltf::BufferView& v = m.bufferViews.at(view);
+        return m.buffers.at(v.buffer).data.data() + v.byteOffset + offset;
+    };
+    if (a.bufferView >= 0) std::memcpy(out.data(), bytes(a.bufferView, a.byteOffset), out.size() * 4);
+    if (a.sparse.isSparse) {
+        const unsigned char* idx = bytes(a.sparse.indices.bufferView, a.sparse.indices.byteOffset);
+        const auto* values = reinterpret_cast<const float*>(bytes(a.sparse.values.bufferView, a.sparse.values.byteOffset));
+        for (int i = 0; i < a.sparse.count; ++i) {
+            std::uint32_t k = 0;
+            if (a.sparse.indices.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) {
+                std::uint16_t s;
+                std::memcpy(&s, idx + 2 * i, 2);
+                k = s;
+            } else {
+                std::memcpy(&k, idx + 4 * i, 4);
+            }
+            EXPECT_LT(k, a.count);
+            if (k < a.count) std::copy_n(values + comps * i, comps, out.begin() + comps * k);
+        }
+    }
     return out;
 }
 
@@ -162,7 +186,8 @@ TEST_F(ExportCli, TargetsAreNamedAndTheAnimationHasTheFileTimes) {
         EXPECT_NE(std::find(names.begin(), names.end(), n), names.end()) << n;
     EXPECT_EQ(std::count_if(names.begin(), names.end(), [](const std::string& s) { return s.rfind("viseme_", 0) == 0; }),
               14);
-    ASSERT_EQ(m.images.size(), 1u);  // the base colour, embedded
+    EXPECT_EQ(std::count_if(m.images.begin(), m.images.end(), [](const tinygltf::Image& i) { return i.name == "base_colour"; }),
+              1);  // the base colour, embedded
     ASSERT_EQ(m.animations.size(), 1u);
     const std::vector<float> t = floats(m, m.animations[0].samplers[0].input);
     const std::vector<float> w = floats(m, m.animations[0].samplers[0].output);
@@ -217,7 +242,8 @@ TEST_F(ExportCli, ReproducesTheRigOnRealFapFiles) {
         const ex::Animation anim = ex::read_animation_file(file.string(), kData);
         if (anim.stream.frames.empty()) continue;
         const std::string out = path(file.stem().string() + ".glb");
-        CommandResult r = run_emoface({"export", file.string(), "--out", out, "--face-resolution", kResolution});
+        CommandResult r =
+            run_emoface({"export", file.string(), "--out", out, "--face-resolution", kResolution, "--no-wrinkles"});
         ASSERT_EQ(r.exit_code, 0) << r.err;
         const tinygltf::Model m = load_glb(out);
         const std::size_t nf = anim.stream.frames.size();
@@ -233,13 +259,89 @@ TEST_F(ExportCli, ReproducesTheRigOnRealFapFiles) {
             }
         }
         std::printf("%s: worst vertex %.4f ES0 (frame %zu)\n", file.filename().c_str(), worst / es0, worst_frame);
-        // Issue 14 asks for 0.02 ES0; measured 0.006..0.18 ES0 (6 of 16 files
-        // within 0.02): the lids' slide over the eyeballs and the lashes'
-        // turn are not linear in the FAPs, and their targets are linearised
-        // about neutral. This bound catches a broken export (a wrong joint,
-        // target or weight is off by whole ES0), not that remaining error.
-        EXPECT_LT(worst / es0, 0.2) << file << " frame " << worst_frame;
+        EXPECT_LT(worst / es0, 0.02) << file << " frame " << worst_frame;
     }
+}
+
+// Each part of the face has its own material (its own primitive over the
+// shared vertices), the wet ones glossier than skin; together they hold every
+// triangle once.
+TEST_F(ExportCli, PartsHaveTheirOwnMaterials) {
+    const std::string out = path("parts.glb");
+    CommandResult r = run_emoface({"export", "--out", out, "--face-resolution", kResolution, "--no-wrinkles"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const tinygltf::Model m = load_glb(out);
+    std::map<std::string, double> roughness;
+    std::size_t indices = 0;
+    for (const tinygltf::Primitive& p : m.meshes.at(0).primitives) {
+        const tinygltf::Material& mat = m.materials.at(p.material);
+        roughness[mat.name] = mat.pbrMetallicRoughness.roughnessFactor;
+        EXPECT_GT(m.accessors.at(p.indices).count, 0u) << mat.name;
+        indices += m.accessors[p.indices].count;
+        EXPECT_EQ(p.attributes.at("POSITION"), m.meshes[0].primitives[0].attributes.at("POSITION"));
+        EXPECT_EQ(p.targets.size(), m.meshes[0].primitives[0].targets.size());
+        EXPECT_EQ(mat.pbrMetallicRoughness.baseColorTexture.index, 0) << mat.name;
+    }
+    for (const char* part : {"skin", "eyes", "teeth", "mouth", "lashes"}) EXPECT_EQ(roughness.count(part), 1u) << part;
+    EXPECT_LT(roughness["eyes"], roughness["teeth"]);
+    EXPECT_LT(roughness["teeth"], roughness["skin"]);
+    EXPECT_LT(roughness["mouth"], roughness["skin"]);
+    ex::DefaultFaceOptions fo;
+    fo.resolution_scale = std::stod(kResolution);
+    EXPECT_EQ(indices, 3 * ex::make_default_face(kData + "/face", fo).mesh.n_faces());
+}
+
+// The wrinkle key maps go along: one per wrinkling AU and side, each a PNG
+// that decodes at the size asked, naming the AU morph target that drives it
+// and carrying its layout; the neutral map is the skin's normal texture on
+// the second UV set; the animation carries each key's weight per frame.
+TEST_F(ExportCli, WrinkleKeysGoAlongWithTheirAuTargets) {
+    const std::string out = path("wrinkles.glb");
+    CommandResult r = run_emoface({"export", kData + "/fap/tour.fap", "--out", out, "--face-resolution", kResolution,
+                                   "--wrinkle-size", "256"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const tinygltf::Model m = load_glb(out);
+    const tinygltf::Value& extras = m.meshes.at(0).extras;
+    if (!extras.Has("wrinkles")) {
+        // Only a build without render/ (no drawing commands) leaves them out.
+        ASSERT_NE(run_emoface({"mix", "--help"}).exit_code, 0) << "a build with render/ exported no wrinkle keys";
+        GTEST_SKIP() << "this build has no render module, whose key plan makes the wrinkle maps";
+    }
+    const tinygltf::Value& w = extras.Get("wrinkles");
+    const std::vector<std::string> names = target_names(m);
+    std::set<int> aus_of_keys;
+    const tinygltf::Value& keys = w.Get("keys");
+    for (std::size_t i = 0; i < keys.ArrayLen(); ++i) {
+        const tinygltf::Value& k = keys.Get(static_cast<int>(i));
+        const std::string name = k.Get("name").Get<std::string>();
+        const int target = k.Get("target").GetNumberAsInt();
+        ASSERT_GE(target, 0) << name;
+        ASSERT_LT(target, static_cast<int>(names.size())) << name;
+        EXPECT_EQ(name.rfind(names[target], 0), 0u) << name << " drives " << names[target];
+        aus_of_keys.insert(std::stoi(names[target].substr(2)));
+        const tinygltf::Image& img = m.images.at(m.textures.at(k.Get("texture").GetNumberAsInt()).source);
+        EXPECT_EQ(img.mimeType, "image/png");
+        EXPECT_EQ(img.width, 256) << name;  // tinygltf decoded it
+        EXPECT_EQ(img.height, 256) << name;
+        EXPECT_EQ(img.image.size(), 256u * 256u * img.component) << name;
+        EXPECT_GT(k.Get("layout").Get("3.5").ArrayLen(), 0u) << name;
+    }
+    std::set<int> wrinkling;
+    for (const auto& au : ex::load_wrinkle_spec(kData + "/expression/wrinkles.json").action_units) wrinkling.insert(au.au);
+    EXPECT_EQ(aus_of_keys, wrinkling);
+    EXPECT_GE(keys.ArrayLen(), wrinkling.size());
+    EXPECT_GT(w.Get("featureLines").ArrayLen(), 0u);
+    const tinygltf::Primitive& prim = m.meshes[0].primitives.at(0);
+    EXPECT_EQ(prim.attributes.count("TEXCOORD_1"), 1u);
+    const tinygltf::Material& skin = m.materials.at(prim.material);
+    EXPECT_EQ(skin.name, "skin");
+    EXPECT_EQ(skin.normalTexture.index, w.Get("neutralTexture").GetNumberAsInt());
+    EXPECT_EQ(skin.normalTexture.texCoord, 1);
+    const tinygltf::Animation& anim = m.animations.at(0);
+    const std::vector<float> kw = floats(m, anim.extras.Get("wrinkleWeights").GetNumberAsInt());
+    const std::vector<float> t = floats(m, anim.samplers.at(0).input);
+    ASSERT_EQ(kw.size(), t.size() * keys.ArrayLen());
+    EXPECT_GT(*std::max_element(kw.begin(), kw.end()), 0.5f);  // the tour shows its AUs
 }
 
 TEST_F(ExportCli, BadInputIsOneLineExitTwoAndNoFile) {
@@ -249,6 +351,7 @@ TEST_F(ExportCli, BadInputIsOneLineExitTwoAndNoFile) {
         {{"export", kData + "/fap/tour.fap", "--mix", "joy", "--out", path("c.glb")}, "not both"},
         {{"export", "--face", path("nope.obj"), "--out", path("d.glb")}, "no such file"},
         {{"export", "--mix", "0.5 glee", "--out", path("e.glb")}, "glee"},
+        {{"export", "--wrinkle-size", "100", "--out", path("f.glb")}, "--wrinkle-size 100: expected 256..4096"},
     };
     for (const auto& [args, says] : cases) {
         CommandResult r = run_emoface(args);
