@@ -103,13 +103,18 @@ double lid_profile(double s, double peak) {
 }
 
 // Cross-section of a lip from where the lips meet (t = 0) to the vermilion
-// border (t = 1) and onto the skin beyond (t > 1, `beyond` in mm).
-double lip_bulge(double t, double peak, double beyond_mm) {
+// border (t = 1, `height_mm` from the meeting line) and onto the skin beyond
+// (t > 1, `beyond` in mm). Past the border the lip's fall continues at the
+// slope it reaches there, easing out into the skin: a fall that stopped on a
+// flat shelf (a Gaussian tail) drew the border as a crease, the outline of a
+// separate lip shape laid on the face.
+double lip_bulge(double t, double peak, double beyond_mm, double height_mm) {
     constexpr double kAtBorder = 0.35;
     if (t <= 0) return 0.0;
     if (t < peak) return std::sin(0.5 * kPi * t / peak);
     if (t <= 1.0) return mix(kAtBorder, 1.0, std::cos(0.5 * kPi * (t - peak) / (1.0 - peak)));
-    return kAtBorder * std::exp(-(beyond_mm / 2.5) * (beyond_mm / 2.5));
+    const double slope = (1.0 - kAtBorder) * 0.5 * kPi / ((1.0 - peak) * std::max(height_mm, 0.5));  // per mm
+    return kAtBorder * std::exp(-beyond_mm * slope / kAtBorder);
 }
 
 }  // namespace
@@ -214,11 +219,11 @@ double FaceShape::lip_relief(double x, double y) const {
     if (y >= ys) {
         const double height = std::max(upper_border(x) - ys, 0.5);
         const double t = (y - ys) / height;
-        h += p_.upper_lip_protrusion * corner_fade * lip_bulge(t, 0.55, std::max(0.0, y - ys - height));
+        h += p_.upper_lip_protrusion * corner_fade * lip_bulge(t, 0.55, std::max(0.0, y - ys - height), height);
     } else {
         const double height = std::max(ys - lower_border(x), 0.5);
         const double t = (ys - y) / height;
-        h += p_.lower_lip_protrusion * corner_fade * lip_bulge(t, 0.45, std::max(0.0, ys - y - height));
+        h += p_.lower_lip_protrusion * corner_fade * lip_bulge(t, 0.45, std::max(0.0, ys - y - height), height);
     }
     return h;
 }
