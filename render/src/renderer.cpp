@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 #include <glm/gtc/matrix_inverse.hpp>
@@ -25,6 +26,32 @@ Camera Camera::look_at(const glm::vec3& eye, const glm::vec3& center, const glm:
     c.projection = glm::perspective(glm::radians(fovy_degrees), aspect, near_plane, far_plane);
     c.position = eye;
     return c;
+}
+
+// 32 triangles a run: on the H100 (row A of frame_e2e, skin shading) runs of
+// 16 to 128 drew within 1% of each other, single triangles 40% slower (lost
+// vertex reuse), 256 3% slower.
+void order_front_first(const expression::TriMesh& mesh, std::vector<std::uint32_t>& triangles) {
+    const std::size_t n = triangles.size() / 3;
+    const std::size_t runs = (n + kFrontFirstRun - 1) / kFrontFirstRun;
+    std::vector<float> depth(runs, 0.0f);
+    for (std::size_t t = 0; t < n; ++t)
+        for (std::size_t c = 0; c < 3; ++c)
+            depth[t / kFrontFirstRun] += mesh.point(mesh.vertex_handle(int(triangles[3 * t + c])))[2];
+    std::vector<std::uint32_t> order(runs);
+    for (std::size_t k = 0; k < runs; ++k) {
+        order[k] = std::uint32_t(k);
+        depth[k] /= float(3 * std::min(kFrontFirstRun, n - k * kFrontFirstRun));
+    }
+    std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return depth[a] > depth[b]; });
+    std::vector<std::uint32_t> sorted;
+    sorted.reserve(triangles.size());
+    for (const std::uint32_t k : order) {
+        const std::size_t begin = 3 * std::size_t(k) * kFrontFirstRun;
+        const std::size_t end = std::min(3 * n, begin + 3 * kFrontFirstRun);
+        sorted.insert(sorted.end(), triangles.begin() + std::ptrdiff_t(begin), triangles.begin() + std::ptrdiff_t(end));
+    }
+    triangles.swap(sorted);
 }
 
 Camera Camera::frontal(const glm::vec3& box_min, const glm::vec3& box_max, float aspect,
@@ -195,6 +222,11 @@ struct Renderer::Impl {
 
     Platform& platform;
     GLuint program = 0;
+    // Whether add_mesh() draws triangles nearest the frontal camera first
+    // (order_front_first): on GPUs, whose depth test rejects fragments
+    // before they are shaded; not on a software rasteriser (llvmpipe),
+    // where the reordered draw was slower.
+    bool front_first = true;
     struct {
         GLint model, normal_matrix, view_projection, base_map, has_base_map, base_color,
             wrinkle_map, use_wrinkle_map, wrinkle_signed, light_position, light_ambient,
@@ -259,6 +291,9 @@ struct Renderer::Impl {
 Renderer::Renderer(Platform& platform) : impl_(std::make_unique<Impl>(platform)) {
     platform.make_current();
     impl_->program = link_program(detail::kBumpVertexShader, detail::kBumpFragmentShader);
+    const auto* gl_renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+    impl_->front_first = !(gl_renderer && (std::strstr(gl_renderer, "llvmpipe") || std::strstr(gl_renderer, "softpipe") ||
+                                          std::strstr(gl_renderer, "SwiftShader")));
     const GLuint p = impl_->program;
     auto u = [p](const char* name) { return glGetUniformLocation(p, name); };
     auto& l = impl_->loc;
@@ -352,6 +387,7 @@ Renderer::MeshId Renderer::add_mesh(const expression::TriMesh& mesh, const Mater
                  fh.idx(), k);
         indices.insert(indices.end(), tri, tri + 3);
     }
+    if (impl_->front_first) order_front_first(mesh, indices);
     m.index_count = GLsizei(indices.size());
     m.base_uvs.assign(m.vertex_count, glm::vec2(0.0f));
     if (mesh.has_vertex_texcoords2D())

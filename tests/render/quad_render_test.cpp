@@ -7,6 +7,7 @@
 // energy bounded, Fresnel rising at grazing angles, a monotonic tone curve.
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <iterator>
 #include <memory>
@@ -596,6 +597,52 @@ TEST_F(SkinQuad, AlbedoReliefLeansTheNormalDownItsSlope) {
     EXPECT_GT(plus, 1.1f * minus) << "the step down towards +x faces the light from +x";
     EXPECT_GT(plus, flat_plus);
     EXPECT_LT(minus, flat_minus);
+}
+
+// The GPU draw order: runs of kFrontFirstRun triangles nearest +z first, each
+// run whole and in its own order, every triangle kept once. Three layers of
+// two runs each are listed back (z 0), front (z 2), middle (z 1), and a
+// short last run of one triangle lies in front of all.
+TEST(DrawOrder, RunsNearestTheFrontalCameraFirst) {
+    TriMesh mesh;
+    const float layer_z[3] = {0.0f, 2.0f, 1.0f};
+    std::vector<std::uint32_t> triangles;
+    std::vector<float> triangle_z;
+    for (const float z : layer_z)
+        for (std::size_t t = 0; t < 2 * kFrontFirstRun; ++t) {
+            for (int c = 0; c < 3; ++c) {
+                // Each triangle's own vertices, leaning a little within the
+                // layer so that a run's mean stays the layer's depth.
+                const float x = float(t) + (c == 1 ? 1.0f : 0.0f), y = c == 2 ? 1.0f : 0.0f;
+                const float lean = 0.01f * (float(c) - 1.0f);
+                triangles.push_back(std::uint32_t(mesh.add_vertex({x, y, z + lean}).idx()));
+            }
+            triangle_z.push_back(z);
+        }
+    for (int c = 0; c < 3; ++c) triangles.push_back(std::uint32_t(mesh.add_vertex({float(c), float(c == 2), 5.0f}).idx()));
+    triangle_z.push_back(5.0f);
+    const std::vector<std::uint32_t> given = triangles;
+
+    order_front_first(mesh, triangles);
+    ASSERT_EQ(triangles.size(), given.size());
+    // Each triangle's vertices are its own (first vertex index / 3 = the
+    // triangle it was listed as), so the order can be read back.
+    std::vector<std::size_t> listed;
+    for (std::size_t t = 0; t < triangles.size() / 3; ++t) {
+        const std::uint32_t first = triangles[3 * t];
+        ASSERT_EQ(first % 3, 0u);
+        EXPECT_EQ(triangles[3 * t + 1], first + 1);
+        EXPECT_EQ(triangles[3 * t + 2], first + 2);
+        listed.push_back(first / 3);
+    }
+    std::vector<std::size_t> expected;
+    expected.push_back(6 * kFrontFirstRun);                                            // the short run at z 5
+    for (std::size_t t = 2 * kFrontFirstRun; t < 4 * kFrontFirstRun; ++t) expected.push_back(t);  // front
+    for (std::size_t t = 4 * kFrontFirstRun; t < 6 * kFrontFirstRun; ++t) expected.push_back(t);  // middle
+    for (std::size_t t = 0; t < 2 * kFrontFirstRun; ++t) expected.push_back(t);                   // back
+    EXPECT_EQ(listed, expected);
+    for (std::size_t i = 1; i < listed.size(); ++i)
+        EXPECT_GE(triangle_z[listed[i - 1]], triangle_z[listed[i]]) << "position " << i;
 }
 
 #ifdef EMOFACE_DATA_DIR
