@@ -724,15 +724,18 @@ NormalMap height_to_normal_map(const std::vector<float>& height, int size, float
             px[1] = encode(-dy / len);
             px[2] = encode(1.0f / len);
             // The cavity: only valleys occlude, by how far they lie below
-            // the skin around them.
+            // the skin around them. Linear, not saturating at full_depth:
+            // the two halves of a wrinkle split at the midline (AU9L, AU9R)
+            // add up in the morph to the whole wrinkle's cavity, where a
+            // clamp per half would darken a seam along the midline.
             const float h = height[static_cast<size_t>(r) * size + c];
             if (h >= 0.0f) {
                 px[3] = 255;
                 continue;
             }
             const float below = around[static_cast<size_t>(r - h0) * ww + (c - w0)] - h;
-            const float occlusion = std::clamp(below / full_depth, 0.0f, 1.0f);
-            px[3] = encode(2.0f * (1.0f - (1.0f - cavity.darkest) * occlusion) - 1.0f);
+            const float occlusion = std::max(below / full_depth, 0.0f);
+            px[3] = encode(2.0f * std::max(1.0f - (1.0f - cavity.darkest) * occlusion, 0.0f) - 1.0f);
         }
     });
     return map;

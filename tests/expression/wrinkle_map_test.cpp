@@ -583,6 +583,107 @@ TEST(FoldShape, TaperEndFadesTheLineOutwards) {
     EXPECT_LT(near_end, 0.6f * near_start);
 }
 
+// A straight horizontal groove across the cheeks of the joy layout (well
+// away from the hairline), `count` copies `step` apart, as the one wrinkle
+// of a library (across the midline, whole); its height field at 512.
+std::vector<float> cheek_groove_field(float depth, float width, int count, glm::vec2 step) {
+    WrinkleLibrarySpec library = spec();
+    WrinkleSpec w;
+    w.name = "test groove";
+    w.depth = depth;
+    w.width = width;
+    w.taper = 0.15f;
+    w.count = count;
+    w.step = step;
+    w.points = {AnchoredPoint{fap::feature_point_index("3.12"), -1, 0.5f, {-0.1f, -0.35f}},
+                AnchoredPoint{fap::feature_point_index("3.7"), -1, 0.5f, {0.1f, -0.35f}}};
+    library.action_units = {AuWrinkles{12, {}, {}, {w}}};
+    return render_height_field(library, {{12, AuSide::Both, 1.0f}}, key_layout("joy"), 512);
+}
+
+// The deepest point of column `col` between rows r0 and r1 (a positive depth).
+float floor_depth(const std::vector<float>& height, int col, int r0 = 0, int r1 = 511) {
+    float deepest = 0.0f;
+    for (int r = std::max(r0, 0); r <= std::min(r1, 511); ++r) deepest = std::min(deepest, height[r * 512 + col]);
+    return -deepest;
+}
+
+// A fold swells and thins gently along its length (issue 11), instead of
+// keeping one depth like a stroke of a pen: over its middle the floor's
+// depth varies clearly, yet smoothly from column to column.
+TEST(FoldShape, DepthSwellsAndThinsSmoothlyAlongTheFold) {
+    const std::vector<float> height = cheek_groove_field(0.02f, 0.02f, 1, {0.0f, 0.0f});
+    const FeatureLayout& layout = key_layout("joy");
+    const float x0 = layout.at("3.12").x, x1 = layout.at("3.7").x;
+    const int c0 = static_cast<int>((x0 + 0.3f * (x1 - x0)) * 512), c1 = static_cast<int>((x0 + 0.7f * (x1 - x0)) * 512);
+    float shallowest = 1e9f, deepest = 0.0f, biggest_step = 0.0f, previous = floor_depth(height, c0);
+    for (int c = c0; c <= c1; ++c) {
+        const float d = floor_depth(height, c);
+        shallowest = std::min(shallowest, d);
+        deepest = std::max(deepest, d);
+        biggest_step = std::max(biggest_step, std::abs(d - previous));
+        previous = d;
+    }
+    std::printf("floor depth over the middle: %.5f .. %.5f, largest step between columns %.5f\n", shallowest,
+                deepest, biggest_step);
+    ASSERT_GT(deepest, 0.0f);
+    EXPECT_GT((deepest - shallowest) / deepest, 0.15f) << "the fold keeps one depth along its length";
+    EXPECT_LT(biggest_step, 0.05f * deepest) << "the depth jumps between neighbouring columns";
+}
+
+// Parallel copies of a fold are not one stroke repeated: their depths and
+// lengths differ.
+TEST(FoldShape, ParallelFoldsDiffer) {
+    const float step = 0.1f;
+    const std::vector<float> height = cheek_groove_field(0.02f, 0.02f, 3, {0.0f, step});
+    const FeatureLayout& layout = key_layout("joy");
+    const float unit = layout.face_unit();
+    // Each copy's band of rows: the line's row moved up by k steps (+- half a step).
+    const float row0 = layout.at("3.7").y + 0.35f * unit;
+    const int half = static_cast<int>(0.5f * step * unit * 512);
+    std::vector<float> depth, length;
+    for (int k = 0; k < 3; ++k) {
+        const int centre = static_cast<int>((row0 - k * step * unit) * 512);
+        float deepest = 0.0f;
+        for (int c = 0; c < 512; ++c) deepest = std::max(deepest, floor_depth(height, c, centre - half, centre + half));
+        int columns = 0;
+        for (int c = 0; c < 512; ++c) columns += floor_depth(height, c, centre - half, centre + half) > 0.25f * deepest;
+        depth.push_back(deepest);
+        length.push_back(static_cast<float>(columns));
+        std::printf("copy %d: deepest %.5f, %d columns deeper than a quarter of it\n", k, deepest, columns);
+    }
+    for (int a = 0; a < 3; ++a)
+        for (int b = a + 1; b < 3; ++b) {
+            ASSERT_GT(depth[a], 0.0f);
+            EXPECT_GT(std::abs(depth[a] - depth[b]) + std::abs(length[a] - length[b]) / length[a] * depth[a],
+                      0.03f * depth[a])
+                << "copies " << a << " and " << b << " are the same fold";
+        }
+}
+
+// The cavity says how enclosed a valley is: a narrow crease is darker at
+// its floor than a broad fold of the same depth (which lies open in its
+// own wide walls), so fine lines read as creases and broad folds as soft
+// shading.
+TEST(Cavity, NarrowCreasesAreDarkerThanBroadFoldsOfTheSameDepth) {
+    constexpr int kSize = 512;
+    const float face_unit = 0.2f, depth = 0.012f * face_unit;
+    const auto floor_alpha = [&](float sigma) {
+        std::vector<float> height(kSize * kSize);
+        for (int r = 0; r < kSize; ++r)
+            for (int c = 0; c < kSize; ++c) {
+                const float y = (r + 0.5f) / kSize - 0.5f;
+                height[r * kSize + c] = -depth * std::exp(-0.5f * y * y / (sigma * sigma));
+            }
+        const NormalMap map = height_to_normal_map(height, kSize, face_unit, spec().cavity);
+        return static_cast<int>(map.rgba[(static_cast<size_t>(kSize / 2) * kSize + kSize / 2) * 4 + 3]);
+    };
+    const int narrow = floor_alpha(0.012f * face_unit), broad = floor_alpha(0.06f * face_unit);
+    std::printf("cavity at the floor: narrow crease %d, broad fold %d\n", narrow, broad);
+    EXPECT_LT(narrow, 160) << "a narrow crease should be clearly occluded";
+    EXPECT_GT(broad, narrow + 50) << "a broad fold should stay far more open than a crease of its depth";
+}
+
 // The hairline of a layout at column x: the polyline 11.2 - 11.1 - 11.3.
 float hairline_y(const FeatureLayout& l, float x) {
     std::vector<glm::vec2> line = {l.at("11.2"), l.at("11.1"), l.at("11.3")};

@@ -85,8 +85,8 @@ struct FoldShape {
 // lies below the skin around it (the height field's Gaussian mean of sigma
 // `radius`): narrow creases darken, broad shallow folds barely.
 struct CavitySpec {
-    float full_depth = 0.025f;  // face units: a floor this far below its surroundings gets the darkest cavity
-    float darkest = 0.35f;      // alpha at or below full_depth
+    float full_depth = 0.025f;  // face units: a floor this far below its surroundings gets `darkest` ...
+    float darkest = 0.35f;      // ... (linear in the depth below them, down to 0, so split halves add up)
     float radius = 0.04f;       // face units: the surroundings' sigma
 };
 
