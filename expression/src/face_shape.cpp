@@ -69,6 +69,29 @@ double bumps_value(const Bump& b, double x, double y) {
     return v;
 }
 
+// A nostril: the bump's ellipse narrowed towards its medial end (a
+// teardrop, wide at the ala, its point towards the columella), so the
+// opening reads as a nostril's, not a drilled round dot.
+double nostril_value(const Bump& b, double x, double y, double sign) {
+    constexpr double kMedialWidth = 0.55;  // the medial end's width, of the lateral end's
+    const double cx = b.centre[0] * sign;
+    const double a = b.angle_deg * kPi / 180.0 * sign;
+    const double dx = x - cx, dy = y - b.centre[1];
+    const double u = (dx * std::cos(a) + dy * std::sin(a)) / b.radius[0];
+    const double lateral = std::clamp(0.5 * (1.0 + u * sign), 0.0, 1.0);  // 0 medial end .. 1 lateral end
+    const double v = (-dx * std::sin(a) + dy * std::cos(a)) / (b.radius[1] * mix(kMedialWidth, 1.0, std::sqrt(lateral)));
+    const double r2 = u * u + v * v;
+    if (r2 >= 1.0) return 0.0;
+    const double k = 1.0 - r2;
+    return k * k * k;
+}
+
+double nostrils_value(const Bump& b, double x, double y) {
+    double v = nostril_value(b, x, y, 1.0);
+    if (b.mirror) v += nostril_value(b, x, y, -1.0);
+    return v;
+}
+
 double ridge_value(const Ridge& r, double x, double y, double sign) {
     double best_d2 = std::numeric_limits<double>::max();
     double best_w = 1, best_h = 0;
@@ -231,7 +254,7 @@ double FaceShape::lip_relief(double x, double y) const {
 double FaceShape::relief(double x, double y) const {
     double h = 0.0;
     for (const Bump& b : p_.bumps) h += b.height * bumps_value(b, x, y);
-    for (const Bump& b : p_.nostrils) h += b.height * bumps_value(b, x, y);
+    for (const Bump& b : p_.nostrils) h += b.height * nostrils_value(b, x, y);
     for (const Ridge& r : p_.ridges) {
         h += ridge_value(r, x, y, 1.0);
         if (r.mirror) h += ridge_value(r, x, y, -1.0);
@@ -241,7 +264,7 @@ double FaceShape::relief(double x, double y) const {
 
 double FaceShape::nostril_amount(double x, double y) const {
     double a = 0.0;
-    for (const Bump& b : p_.nostrils) a += bumps_value(b, x, y);
+    for (const Bump& b : p_.nostrils) a += nostrils_value(b, x, y);
     return std::min(a, 1.0);
 }
 

@@ -513,7 +513,8 @@ Texel Painter::skin(glm::dvec3 q) const {
         }
         // Nostrils.
         const double n = s_.nostril_amount(q.x, q.y);
-        if (n > 0) c = blend(c, Rgb{0.25, 0.12, 0.11}, glm::smoothstep(0.05, 0.5, n));
+        // Dark only deep in the opening; its rim is skin, shaded by the dent.
+        if (n > 0) c = blend(c, Rgb{0.25, 0.12, 0.11}, glm::smoothstep(0.2, 0.85, n));
         c = blend(side_colour, c, front);
         gloss = mix(side_gloss, gloss, front);
     }
