@@ -228,6 +228,21 @@ TEST(DefaultFace, EyeballsSitUnderOpenLidsAndPartsAreContiguous) {
     EXPECT_TRUE(f.has(fp("7.1")));
 }
 
+// The incisors at rest: the upper edge 2-3 mm below where the lips meet
+// (incisal display), the lower edge 1-3 mm above it (overbite) and behind
+// it (overjet), so the lower lip hides the lower teeth until the jaw drops.
+TEST(DefaultFace, IncisorsShowBelowTheUpperLipWithAnOverbite) {
+    const Face& face = test_face();
+    const Vec3d stomion = face.position(fp("2.2"));
+    const Vec3d upper = face.position(fp("9.10")), lower = face.position(fp("9.11"));
+    // Measured: 2.5 mm below, overbite 2.0, overjet 1.8.
+    EXPECT_GT(stomion[1] - upper[1], 2.0);
+    EXPECT_LT(stomion[1] - upper[1], 3.5);
+    EXPECT_GT(lower[1] - upper[1], 1.0);
+    EXPECT_LT(lower[1] - upper[1], 3.0);
+    EXPECT_GT(upper[2] - lower[2], 1.0);
+}
+
 TEST(DefaultFace, BaseColourPaintsLipsRedderThanSkinAndHairDarker) {
     DefaultFaceOptions options;
     options.resolution_scale = 0.5;

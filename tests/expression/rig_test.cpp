@@ -189,6 +189,25 @@ TEST(Rig, OpenJaw512OpensAGapBetweenTheLips) {
     EXPECT_LT(distance(d.feature_points[fp("9.10")], face.position(fp("9.10"))), 1e-4);
 }
 
+// A dropped jaw opens the lips as an oval: widest mid-mouth, narrowing
+// towards the corners, which stay closed (a slot as wide as the mouth read
+// as a letterbox, not a jaw drop).
+TEST(Rig, OpenJawOpensAnOvalNarrowingIntoTheCorners) {
+    FapValues faps{};
+    faps[3 - 1] = 700;
+    const DeformedFace d = test_rig().deform(faps);
+    auto gap = [&](const char* upper, const char* lower) {
+        return d.feature_points[fp(upper)][1] - d.feature_points[fp(lower)][1];
+    };
+    const double mid = gap("2.2", "2.3");
+    const double half_left = gap("2.6", "2.8"), half_right = gap("2.7", "2.9");
+    // Measured: 17.7 mm mid-mouth, 8.7 mm halfway to the corners.
+    EXPECT_GT(half_left, 2.0);
+    EXPECT_GT(half_right, 2.0);
+    EXPECT_LT(half_left, 0.85 * mid);
+    EXPECT_LT(half_right, 0.85 * mid);
+}
+
 TEST(Rig, ClosingEyelids1024PutsUpperOnLowerAlongTheWholeMargin) {
     const Face& face = test_face();
     FapValues faps{};
