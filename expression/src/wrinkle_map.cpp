@@ -587,8 +587,22 @@ WrinkleRegion wrinkle_region(const WrinkleLibrarySpec& spec, const WrinkleSource
     return r;
 }
 
-std::vector<float> render_height_field(const WrinkleLibrarySpec& spec, const WrinkleSources& sources,
-                                       const FeatureLayout& layout, int size) {
+namespace {
+
+// A key's height field and, when asked, the same wrinkles by how the midline
+// shares them: parts[split + 1] holds the strokes of that split (-1, 0, +1)
+// at full strength, before the share. A valley's depth below its
+// surroundings is measured on these whole wrinkles and shared afterwards, so
+// the halves of a wrinkle split between AU9L and AU9R have cavities that
+// add up to the whole wrinkle's (measured on a half, the missing other half
+// reads as open skin and darkens the midline).
+struct KeyFields {
+    std::vector<float> height;
+    std::array<std::vector<float>, 3> parts;  // empty where no stroke has that split
+};
+
+KeyFields render_fields(const WrinkleLibrarySpec& spec, const WrinkleSources& sources, const FeatureLayout& layout,
+                        int size, bool with_parts) {
     if (size < 16 || size > 8192)
         fail<InputError>("expression: render_height_field(): size must be in [16, 8192], found {}", size);
     std::vector<Stroke> strokes = key_strokes(spec, sources, layout);
@@ -608,19 +622,30 @@ std::vector<float> render_height_field(const WrinkleLibrarySpec& spec, const Wri
     const bool detail = sources.empty() && spec.neutral_detail.amplitude > 0.0f;
     const SkinMask mask(layout);
     const float unit = layout.face_unit();
-    std::vector<float> height(static_cast<size_t>(size) * size, 0.0f);
+    KeyFields fields;
+    fields.height.assign(static_cast<size_t>(size) * size, 0.0f);
+    if (with_parts) {
+        for (const Stroke& s : strokes) fields.parts[static_cast<int>(s.split) + 1].assign(fields.height.size(), 0.0f);
+        if (detail) fields.parts[1].assign(fields.height.size(), 0.0f);
+    }
+    std::vector<float>& height = fields.height;
     const float inv = 1.0f / static_cast<float>(size);
     for_each_row_band(size, [&](int row) {
         const float y = (row + 0.5f) * inv;
-        float* out = height.data() + static_cast<size_t>(row) * size;
+        const size_t row_start = static_cast<size_t>(row) * size;
+        float* out = height.data() + row_start;
         for (const Stroke& s : strokes) {
             if (y < s.box_min.y || y > s.box_max.y) continue;
             const int c0 = std::max(0, static_cast<int>(std::floor(s.box_min.x * size)));
             const int c1 = std::min(size - 1, static_cast<int>(std::ceil(s.box_max.x * size)));
+            float* part = with_parts ? fields.parts[static_cast<int>(s.split) + 1].data() + row_start : nullptr;
             for (int col = c0; col <= c1; ++col) {
                 const glm::vec2 x{(col + 0.5f) * inv, y};
                 const float share = midline.weight(x, s.split);
-                if (share > 0.0f) out[col] += share * stroke_height(s, spec.fold, unit, x);
+                if (share <= 0.0f && !part) continue;
+                const float h = stroke_height(s, spec.fold, unit, x);
+                out[col] += share * h;
+                if (part) part[col] += h;
             }
         }
         if (detail) {
@@ -633,16 +658,19 @@ std::vector<float> render_height_field(const WrinkleLibrarySpec& spec, const Wri
                 for (int o = 0; o < d.octaves; ++o, amplitude *= 0.5f, cell *= 0.5f)
                     n += amplitude * value_noise(x / cell, o);
                 out[col] += w * n;
+                if (with_parts) fields.parts[1][row_start + col] += w * n;
             }
         }
         // Wrinkles and skin detail alike stop below the hairline.
-        for (int col = 0; col < size; ++col)
-            if (out[col] != 0.0f) out[col] *= area.pixel({(col + 0.5f) * inv, y});
+        for (int col = 0; col < size; ++col) {
+            const float keep = area.pixel({(col + 0.5f) * inv, y});
+            if (out[col] != 0.0f) out[col] *= keep;
+            for (std::vector<float>& part : fields.parts)
+                if (!part.empty()) part[row_start + col] *= keep;
+        }
     });
-    return height;
+    return fields;
 }
-
-namespace {
 
 // Box-filters `line` (n values, `stride` apart) in place, `passes` times,
 // each a running mean over 2 r + 1 values with the ends held: three passes
@@ -662,10 +690,62 @@ void box_blur_line(float* line, int n, int stride, int r, int passes, std::vecto
     }
 }
 
+// How far each point of `field` lies below its surroundings (a Gaussian
+// of sigma `blur` px: three box passes), over the window [w0, w1] x [h0, h1],
+// row-major in the window.
+std::vector<float> depth_below_surroundings(const std::vector<float>& field, int size, int blur, int w0, int w1,
+                                            int h0, int h1) {
+    const int ww = w1 - w0 + 1, wh = h1 - h0 + 1;
+    std::vector<float> around(static_cast<size_t>(ww) * wh);
+    for (int r = h0; r <= h1; ++r)
+        std::memcpy(&around[static_cast<size_t>(r - h0) * ww], &field[static_cast<size_t>(r) * size + w0],
+                    sizeof(float) * static_cast<size_t>(ww));
+    parallel_for(wh, 16, [&](int begin, int end) {
+        std::vector<float> scratch;
+        for (int r = begin; r < end; ++r) box_blur_line(&around[static_cast<size_t>(r) * ww], ww, 1, blur, 3, scratch);
+    });
+    parallel_for(ww, 16, [&](int begin, int end) {
+        std::vector<float> scratch;
+        for (int c = begin; c < end; ++c) box_blur_line(&around[static_cast<size_t>(c)], wh, ww, blur, 3, scratch);
+    });
+    for (int r = h0; r <= h1; ++r)
+        for (int c = w0; c <= w1; ++c)
+            around[static_cast<size_t>(r - h0) * ww + (c - w0)] -= field[static_cast<size_t>(r) * size + c];
+    return around;
+}
+
+// The normal map of `height` with its cavity in alpha; `below(r, c)` says
+// how far a point lies below its surroundings (in the window the caller
+// measured: the region and the blur's reach around it).
+template <typename BelowFn>
+NormalMap encode_normal_map(const std::vector<float>& height, int size, float face_unit, const CavitySpec& cavity,
+                            const WrinkleRegion& region, BelowFn&& below);
+
+// The window around `region` (one pixel more, for the differences) and the
+// blur's reach beyond it, at `size`.
+struct CavityWindow {
+    int c0, c1, r0, r1;  // the region
+    int blur;
+    int w0, w1, h0, h1;  // the window measured
+    CavityWindow(const WrinkleRegion& region, int size, float face_unit, const CavitySpec& cavity) {
+        c0 = std::max(0, static_cast<int>(std::floor(region.min.x * size)) - 1);
+        c1 = std::min(size - 1, static_cast<int>(std::ceil(region.max.x * size)) + 1);
+        r0 = std::max(0, static_cast<int>(std::floor(region.min.y * size)) - 1);
+        r1 = std::min(size - 1, static_cast<int>(std::ceil(region.max.y * size)) + 1);
+        blur = std::max(1, static_cast<int>(std::lround(cavity.radius * face_unit * size)));
+        w0 = std::max(0, c0 - 3 * blur), w1 = std::min(size - 1, c1 + 3 * blur);
+        h0 = std::max(0, r0 - 3 * blur), h1 = std::min(size - 1, r1 + 3 * blur);
+    }
+    size_t at(int r, int c) const { return static_cast<size_t>(r - h0) * (w1 - w0 + 1) + (c - w0); }
+};
+
 }  // namespace
 
-NormalMap height_to_normal_map(const std::vector<float>& height, int size, float face_unit,
-                               const CavitySpec& cavity, const WrinkleRegion& region) {
+namespace {
+
+template <typename BelowFn>
+NormalMap encode_normal_map(const std::vector<float>& height, int size, float face_unit, const CavitySpec& cavity,
+                            const WrinkleRegion& region, BelowFn&& below) {
     // Heights and positions share normalised units; the cavity's lengths
     // are in face units.
     const float full_depth = cavity.full_depth * face_unit;
@@ -678,11 +758,7 @@ NormalMap height_to_normal_map(const std::vector<float>& height, int size, float
         map.rgba[i + 2] = map.rgba[i + 3] = 255;
     }
     if (region.empty()) return map;
-    // One pixel more on each side: a difference reaches its neighbours.
-    const int c0 = std::max(0, static_cast<int>(std::floor(region.min.x * size)) - 1);
-    const int c1 = std::min(size - 1, static_cast<int>(std::ceil(region.max.x * size)) + 1);
-    const int r0 = std::max(0, static_cast<int>(std::floor(region.min.y * size)) - 1);
-    const int r1 = std::min(size - 1, static_cast<int>(std::ceil(region.max.y * size)) + 1);
+    const CavityWindow win(region, size, face_unit, cavity);
     const float scale = static_cast<float>(size) * 0.5f;  // central difference over 2 px of 1/size
     const auto at = [&](int r, int c) {
         r = std::clamp(r, 0, size - 1);
@@ -692,30 +768,9 @@ NormalMap height_to_normal_map(const std::vector<float>& height, int size, float
     const auto encode = [](float v) {
         return static_cast<std::uint8_t>(std::clamp(std::lround((0.5f + 0.5f * v) * 255.0f), 0L, 255L));
     };
-    // The skin around each point (a Gaussian of sigma cavity.radius): how far
-    // a valley floor lies below it is how enclosed it is. A narrow crease
-    // is nearly as deep below its surroundings as it is deep, and dark; a
-    // broad shallow fold of the same depth lies in its own walls, and stays
-    // open. Over the region and the blur's reach beyond it (zero heights).
-    const int blur = std::max(1, static_cast<int>(std::lround(cavity.radius * face_unit * size)));
-    const int w0 = std::max(0, c0 - 3 * blur), w1 = std::min(size - 1, c1 + 3 * blur);
-    const int h0 = std::max(0, r0 - 3 * blur), h1 = std::min(size - 1, r1 + 3 * blur);
-    const int ww = w1 - w0 + 1, wh = h1 - h0 + 1;
-    std::vector<float> around(static_cast<size_t>(ww) * wh);
-    for (int r = h0; r <= h1; ++r)
-        std::memcpy(&around[static_cast<size_t>(r - h0) * ww], &height[static_cast<size_t>(r) * size + w0],
-                    sizeof(float) * static_cast<size_t>(ww));
-    parallel_for(wh, 16, [&](int begin, int end) {
-        std::vector<float> scratch;
-        for (int r = begin; r < end; ++r) box_blur_line(&around[static_cast<size_t>(r) * ww], ww, 1, blur, 3, scratch);
-    });
-    parallel_for(ww, 16, [&](int begin, int end) {
-        std::vector<float> scratch;
-        for (int c = begin; c < end; ++c) box_blur_line(&around[static_cast<size_t>(c)], wh, ww, blur, 3, scratch);
-    });
-    for_each_row_band(r1 - r0 + 1, [&](int band_row) {
-        const int r = r0 + band_row;
-        for (int c = c0; c <= c1; ++c) {
+    for_each_row_band(win.r1 - win.r0 + 1, [&](int band_row) {
+        const int r = win.r0 + band_row;
+        for (int c = win.c0; c <= win.c1; ++c) {
             const float dx = (at(r, c + 1) - at(r, c - 1)) * scale;
             const float dy = (at(r + 1, c) - at(r - 1, c)) * scale;
             const float len = std::sqrt(dx * dx + dy * dy + 1.0f);
@@ -724,29 +779,67 @@ NormalMap height_to_normal_map(const std::vector<float>& height, int size, float
             px[1] = encode(-dy / len);
             px[2] = encode(1.0f / len);
             // The cavity: only valleys occlude, by how far they lie below
-            // the skin around them. Linear, not saturating at full_depth:
-            // the two halves of a wrinkle split at the midline (AU9L, AU9R)
-            // add up in the morph to the whole wrinkle's cavity, where a
-            // clamp per half would darken a seam along the midline.
-            const float h = height[static_cast<size_t>(r) * size + c];
-            if (h >= 0.0f) {
+            // the skin around them. Linear, not saturating at full_depth, so
+            // the keys' cavities add up in the morph as their heights do.
+            if (height[static_cast<size_t>(r) * size + c] >= 0.0f) {
                 px[3] = 255;
                 continue;
             }
-            const float below = around[static_cast<size_t>(r - h0) * ww + (c - w0)] - h;
-            const float occlusion = std::max(below / full_depth, 0.0f);
+            const float occlusion = std::max(below(win, r, c) / full_depth, 0.0f);
             px[3] = encode(2.0f * std::max(1.0f - (1.0f - cavity.darkest) * occlusion, 0.0f) - 1.0f);
         }
     });
     return map;
 }
 
+}  // namespace
+
+std::vector<float> render_height_field(const WrinkleLibrarySpec& spec, const WrinkleSources& sources,
+                                       const FeatureLayout& layout, int size) {
+    return render_fields(spec, sources, layout, size, false).height;
+}
+
+NormalMap height_to_normal_map(const std::vector<float>& height, int size, float face_unit,
+                               const CavitySpec& cavity, const WrinkleRegion& region) {
+    // The skin around each point (a Gaussian of sigma cavity.radius): how far
+    // a valley floor lies below it is how enclosed it is. A narrow crease
+    // is nearly as deep below its surroundings as it is deep, and dark; a
+    // broad shallow fold of the same depth lies in its own walls, and stays
+    // open.
+    std::vector<float> below;
+    if (!region.empty()) {
+        const CavityWindow w(region, size, face_unit, cavity);
+        below = depth_below_surroundings(height, size, w.blur, w.w0, w.w1, w.h0, w.h1);
+    }
+    return encode_normal_map(height, size, face_unit, cavity, region,
+                             [&](const CavityWindow& w, int r, int c) { return below[w.at(r, c)]; });
+}
+
 NormalMap generate_wrinkle_map(const WrinkleLibrarySpec& spec, const WrinkleSources& sources,
                                const FeatureLayout& layout, int size) {
     if (size < 256 || size > 4096)
         fail<InputError>("expression: generate_wrinkle_map(): size must be in [256, 4096], found {}", size);
-    return height_to_normal_map(render_height_field(spec, sources, layout, size), size, layout.face_unit(),
-                                spec.cavity, wrinkle_region(spec, sources, layout));
+    const KeyFields fields = render_fields(spec, sources, layout, size, true);
+    const WrinkleRegion region = wrinkle_region(spec, sources, layout);
+    const float unit = layout.face_unit();
+    // Each part's depth below its surroundings, measured on whole wrinkles,
+    // then shared at the midline as the heights are.
+    std::array<std::vector<float>, 3> below;
+    if (!region.empty()) {
+        const CavityWindow w(region, size, unit, spec.cavity);
+        for (int k = 0; k < 3; ++k)
+            if (!fields.parts[k].empty())
+                below[k] = depth_below_surroundings(fields.parts[k], size, w.blur, w.w0, w.w1, w.h0, w.h1);
+    }
+    const Midline midline(layout);
+    const float inv = 1.0f / static_cast<float>(size);
+    return encode_normal_map(fields.height, size, unit, spec.cavity, region, [&](const CavityWindow& w, int r, int c) {
+        const glm::vec2 x{(c + 0.5f) * inv, (r + 0.5f) * inv};
+        float sum = 0.0f;
+        for (int k = 0; k < 3; ++k)
+            if (!below[k].empty()) sum += midline.weight(x, static_cast<float>(k - 1)) * below[k][w.at(r, c)];
+        return sum;
+    });
 }
 
 }  // namespace emoface::expression

@@ -684,6 +684,30 @@ TEST(Cavity, NarrowCreasesAreDarkerThanBroadFoldsOfTheSameDepth) {
     EXPECT_GT(broad, narrow + 50) << "a broad fold should stay far more open than a crease of its depth";
 }
 
+// The morph adds the keys' cavities over open skin (1 + sum of w (a - 1)):
+// a wrinkle split at the midline between AU1L and AU1R (AU15L and AU15R)
+// must come back as the whole AU's cavity there, or the midline shows a
+// seam (measured on a half alone, the missing other half reads as open
+// skin beside the valley and darkens it). (AU9's sides differ by up to ~20
+// of 255 at a few pixels where one side's crest overlaps the other side's
+// nasal-root line: raised skin has no cavity, so there the sum is not linear.)
+TEST(Cavity, LeftPlusRightIsTheWholeAusCavity) {
+    const FeatureLayout& layout = key_layout("disgust");
+    for (const int au : {1, 15}) {
+        SCOPED_TRACE("AU" + std::to_string(au));
+        const auto map = [&](AuSide side) { return generate_wrinkle_map(spec(), {{au, side, 1.0f}}, layout, 256); };
+        const NormalMap both = map(AuSide::Both), l = map(AuSide::Left), r = map(AuSide::Right);
+        int worst = 0, darkest = 255;
+        for (std::size_t i = 3; i < both.rgba.size(); i += 4) {
+            worst = std::max(worst, std::abs(int(l.rgba[i]) + int(r.rgba[i]) - 255 - int(both.rgba[i])));
+            darkest = std::min<int>(darkest, both.rgba[i]);
+        }
+        std::printf("AU%d: darkest cavity %d, left + right off by at most %d\n", au, darkest, worst);
+        ASSERT_LT(darkest, 200);
+        EXPECT_LE(worst, 6);
+    }
+}
+
 // The hairline of a layout at column x: the polyline 11.2 - 11.1 - 11.3.
 float hairline_y(const FeatureLayout& l, float x) {
     std::vector<glm::vec2> line = {l.at("11.2"), l.at("11.1"), l.at("11.3")};
