@@ -1,6 +1,7 @@
 #include "emoface/render/renderer.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -170,12 +171,12 @@ GLuint upload_srgb_texture(const ImageRGBA8& image) {
                           image.width, image.height, flipped.data());
 }
 
-// The base colour's relief (skin_maps.h): RG half floats, mipmapped (the
-// filtered slopes are those of the filtered height), rows bottom first like
-// the base texture.
-GLuint upload_detail_map(const ImageRGBA8& image, float mean_levels) {
-    const std::vector<float> slopes = detail::albedo_detail_slopes(image, mean_levels);
-    return upload_texture({GL_RG16F, GL_RG, GL_FLOAT, 4, true, GL_CLAMP_TO_EDGE,
+// The base colour's relief and hair mask (skin_maps.h): RGB half floats,
+// mipmapped (the filtered slopes are those of the filtered height), rows
+// bottom first like the base texture.
+GLuint upload_detail_map(const ImageRGBA8& image, float mean_levels, std::array<float, 2> hair_luminance) {
+    const std::vector<float> slopes = detail::albedo_detail_slopes(image, mean_levels, hair_luminance);
+    return upload_texture({GL_RGB16F, GL_RGB, GL_FLOAT, 4, true, GL_CLAMP_TO_EDGE,
                            "uploading a base texture's relief"},
                           image.width, image.height, slopes.data());
 }
@@ -210,6 +211,7 @@ struct Renderer::Impl {
         // skin draw and again when the mean it is taken against changes.
         GLuint detail_texture = 0;
         float detail_levels = 0.0f;
+        std::array<float, 2> detail_hair{};  // the hair mask's luminance range it was made with
         GLuint vao = 0, shape_vbo = 0, frame_vbo = 0, static_vbo = 0, ebo = 0;
         GLuint occlusion_vbo = 0;  // attribute 5; none: the constant 1 (open)
         GLsizei index_count = 0;
@@ -233,7 +235,7 @@ struct Renderer::Impl {
             light_diffuse, light_specular, specular_color, shininess, camera_position, projective,
             box, skin_model, skin_surface, scatter_table, max_curvature, mm_per_unit,
             normal_softening, cavity_direct, pore_map, pore_tiles, pore_strength, detail_map, albedo_bump, f0, roughness,
-            lobe_weight, gloss_exponent, sheen_intensity, occlusion, min_curvature, wrap, key_tint,
+            lobe_weight, gloss_exponent, sheen_intensity, occlusion, min_curvature, wrap, hair, wet, key_tint,
             fill_direction, fill_colour, rim_direction, rim_colour, sky, ground,
             exposure, tone_map;
     } loc{};
@@ -335,6 +337,8 @@ Renderer::Renderer(Platform& platform) : impl_(std::make_unique<Impl>(platform))
     l.occlusion = u("u_occlusion");
     l.min_curvature = u("u_min_curvature");
     l.wrap = u("u_wrap");
+    l.hair = u("u_hair");
+    l.wet = u("u_wet");
     l.key_tint = u("u_key_tint");
     l.fill_direction = u("u_fill_direction");
     l.fill_colour = u("u_fill_colour");
@@ -600,11 +604,14 @@ void Renderer::draw(const DrawOptions& o, const WrinkleTexture* wrinkle_map) {
         glActiveTexture(GL_TEXTURE4);
         for (auto& m : im.meshes) {
             const bool wanted = k.albedo_bump_mm > 0.0f && m.material.base_texture && m.material.uses_wrinkle_map;
-            if (!wanted || (m.detail_texture && m.detail_levels == k.albedo_bump_bias)) continue;
-            const GLuint t = upload_detail_map(*m.material.base_texture, k.albedo_bump_bias);
+            if (!wanted || (m.detail_texture && m.detail_levels == k.albedo_bump_bias &&
+                            m.detail_hair == k.hair_luminance))
+                continue;
+            const GLuint t = upload_detail_map(*m.material.base_texture, k.albedo_bump_bias, k.hair_luminance);
             if (m.detail_texture) glDeleteTextures(1, &m.detail_texture);
             m.detail_texture = t;
             m.detail_levels = k.albedo_bump_bias;
+            m.detail_hair = k.hair_luminance;
         }
         glUniform1f(im.loc.f0, k.f0);
         glUniform2f(im.loc.roughness, k.roughness[0], k.roughness[1]);
@@ -614,6 +621,8 @@ void Renderer::draw(const DrawOptions& o, const WrinkleTexture* wrinkle_map) {
         glUniform3f(im.loc.occlusion, k.occlusion_key, k.occlusion_fill, k.occlusion_specular);
         glUniform1f(im.loc.min_curvature, k.min_curvature / k.max_curvature);
         glUniform1f(im.loc.wrap, k.softness);
+        glUniform3f(im.loc.hair, k.hair_wrap, k.hair_roughness, k.hair_sheen);
+        glUniform3f(im.loc.wet, k.wet_f0, k.wet_broad_roughness, k.wet_broad_weight);
         glUniform3fv(im.loc.key_tint, 1, glm::value_ptr(k.key_tint));
         glUniform3fv(im.loc.fill_direction, 1, glm::value_ptr(k.fill.direction));
         glUniform3fv(im.loc.fill_colour, 1, glm::value_ptr(k.fill.colour));

@@ -101,7 +101,7 @@ uniform float u_cavity_direct;
 uniform sampler2D u_pore_map;       // rgb normal, a cavity
 uniform float u_pore_tiles;
 uniform float u_pore_strength;
-uniform sampler2D u_detail_map;     // rg: the base colour's relief, slopes per base UV (skin_maps.h)
+uniform sampler2D u_detail_map;     // rg: the base colour's relief, slopes per base UV; b: hair (skin_maps.h)
 uniform float u_albedo_bump;        // detail height (scene units) per unit of the relief
 uniform float u_f0;
 uniform vec2 u_roughness;
@@ -111,6 +111,8 @@ uniform vec2 u_sheen_intensity;     // direct sheen at gloss 1 (matte), gloss at
 uniform vec3 u_occlusion;           // how far the baked occlusion dims: key, fill/rim/sky diffuse, specular
 uniform float u_min_curvature;      // table coordinate: the flattest skin still scatters
 uniform float u_wrap;               // the rig lights' softness (wrapped N.L, energy kept)
+uniform vec3 u_hair;                // hair: wrap, roughness, the lights' sheen
+uniform vec3 u_wet;                 // eyes, mouth: F0, broad lobe's roughness, its weight
 uniform vec3 u_key_tint;
 uniform vec3 u_fill_direction;
 uniform vec3 u_fill_colour;
@@ -182,6 +184,7 @@ struct Surface {
     vec3 diffuse_albedo;  // albedo x the diffuse share (1 - sheen)
     float direct_cavity;  // the cavity's dimming of direct diffuse light
     float curvature; // table row coordinate in [0, 1]
+    float hair;      // 1 on hair: plain diffuse instead of skin's scattering
     float f0;
     vec2 alpha;      // GGX alpha of the two lobes
     float alpha_mean;  // one lobe standing for both (fill and rim)
@@ -218,7 +221,11 @@ vec3 shade_light(Surface s, vec3 l, vec3 c, const bool full) {
             float u = clamp(0.5 + 0.5 * (dot(s.n_g, l) + u_wrap) * wrap_scale, 0.0, 1.0);
             diffuse = textureLod(u_scatter_table, vec2(u, s.curvature), 0.0).rgb * (wrap_scale * s.dim_shadow);
         }
-        diffuse *= s.direct_cavity;
+        // Hair scatters no light under its surface: wrapped Lambert.
+        float hair_wrap_scale = 1.0 / (1.0 + u_hair.x);
+        float lambert = max(dot(s.n, l) + u_hair.x, 0.0) * hair_wrap_scale * hair_wrap_scale *
+                        (full ? s.key_shadow : s.dim_shadow);
+        diffuse = mix(diffuse, vec3(lambert), s.hair) * s.direct_cavity;
     } else {
         diffuse = vec3(max(dot(s.n, l), 0.0));
     }
@@ -242,11 +249,16 @@ vec3 shade_light(Surface s, vec3 l, vec3 c, const bool full) {
 // `slope`: the base colour's relief (its log-luminance above its local mean,
 // baked at load), d height / d base UV in scene units: hair strands, brow
 // hairs and lip lines stand out of the darker gaps between them.
-vec3 shade_skin(vec3 n_bumped, vec3 n_geo, vec3 base, float cavity, float gloss, vec2 slope) {
+// `hair`: 1 on the scalp's hair and the brows (the relief map's third
+// channel), whose diffuse light is plain and whose sheen is one broad, dim
+// lobe.
+vec3 shade_skin(vec3 n_bumped, vec3 n_geo, vec3 base, float cavity, float gloss, vec2 slope, float hair) {
     Surface s;
     s.v = normalize(u_camera_position - v_position);
     s.cavity = cavity;
     s.direct_sheen = 1.0;
+    s.hair = hair;
+    s.f0 = u_f0;
     vec2 roughness;
     float occlusion = 1.0;
     if (u_skin_surface) {
@@ -255,7 +267,8 @@ vec3 shade_skin(vec3 n_bumped, vec3 n_geo, vec3 base, float cavity, float gloss,
         // and the wet lid margins (gloss below 1) sharper and fuller.
         float g = clamp(gloss, 0.3, 1.0);
         roughness = u_roughness * pow(g, u_gloss_exponent);
-        s.direct_sheen = mix(1.0, u_sheen_intensity.x, smoothstep(u_sheen_intensity.y, 1.0, g));
+        s.direct_sheen = mix(mix(1.0, u_sheen_intensity.x, smoothstep(u_sheen_intensity.y, 1.0, g)), u_hair.z, hair);
+        roughness = mix(roughness, vec2(u_hair.y), hair);
         occlusion = v_occlusion;
         s.lobe_weight = u_lobe_weight;
         // Pores, in the frame of the base UVs built from screen derivatives
@@ -299,18 +312,20 @@ vec3 shade_skin(vec3 n_bumped, vec3 n_geo, vec3 base, float cavity, float gloss,
         s.n_g = normalize(mix(s.n, n_geo, u_normal_softening.g));
         s.n_b = normalize(mix(s.n, n_geo, u_normal_softening.b));
     } else {
-        // Eyes, mouth: one lobe of the roughness matching the Blinn-Phong
-        // exponent (Walter et al. 2007: alpha = sqrt(2 / (s + 2))).
+        // Eyes, mouth: wet. A tight lobe of the roughness matching the
+        // Blinn-Phong exponent (Walter et al. 2007: alpha = sqrt(2 / (s + 2)))
+        // and a weak broad one, under the tear film's Fresnel.
         float alpha = sqrt(2.0 / (u_shininess + 2.0));
-        roughness = vec2(sqrt(alpha));
-        s.lobe_weight = 1.0;
+        roughness = vec2(sqrt(alpha), u_wet.y);
+        s.lobe_weight = 1.0 - u_wet.z;
+        s.f0 = u_wet.x;
         s.n = n_bumped;
         s.n_r = s.n_g = s.n_b = s.n;
         s.curvature = 0.0;
     }
     s.alpha = max(roughness * roughness, vec2(1e-3));
     // The cavity dims F0 (Jimenez et al. 2013): crevices lose their sheen.
-    s.f0 = u_f0 * s.cavity;
+    s.f0 *= s.cavity;
     s.n_dot_v = max(dot(s.n, s.v), 1e-4);
     float mean_roughness = mix(roughness.y, roughness.x, s.lobe_weight);
     s.alpha_mean = max(mean_roughness * mean_roughness, 1e-3);
@@ -367,17 +382,22 @@ void main() {
     vec3 base = u_base_color;
     float gloss = 1.0;
     vec2 slope = vec2(0.0);
+    float hair = 0.0;
     if (u_has_base_map) {
         vec4 texel = texture(u_base_map, v_base_uv);
         base *= texel.rgb;
         if (u_skin_model) {
             gloss = texel.a;
-            if (u_skin_surface && u_albedo_bump > 0.0) slope = (u_albedo_bump / u_pore_tiles) * texture(u_detail_map, v_base_uv).rg;
+            if (u_skin_surface && u_albedo_bump > 0.0) {
+                vec3 detail = texture(u_detail_map, v_base_uv).rgb;
+                slope = (u_albedo_bump / u_pore_tiles) * detail.rg;
+                hair = detail.b;
+            }
         }
     }
 
     if (u_skin_model) {
-        vec3 color = u_exposure * shade_skin(n, n_geo, base, cavity, gloss, slope);
+        vec3 color = u_exposure * shade_skin(n, n_geo, base, cavity, gloss, slope, hair);
         frag_color = vec4(srgb_encode(u_tone_map ? tone_map(color) : color), 1.0);
         return;
     }

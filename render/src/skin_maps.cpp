@@ -154,12 +154,16 @@ std::vector<std::uint8_t> pore_map(const PoreMapSpec& spec) {
     return out;
 }
 
-std::vector<float> albedo_detail_slopes(const ImageRGBA8& image, float mean_levels) {
+std::vector<float> albedo_detail_slopes(const ImageRGBA8& image, float mean_levels,
+                                        std::array<float, 2> hair_luminance) {
     const int w = image.width, h = image.height;
     if (w < 2 || h < 2 || image.pixels.size() != std::size_t(w) * h * 4 || !(mean_levels > 0.0f))
         fail("render: albedo detail of a {}x{} image with {} bytes (expected width*height*4, at least 2x2) "
              "over {} mip levels (expected > 0)",
              w, h, image.pixels.size(), mean_levels);
+    if (!(hair_luminance[0] < hair_luminance[1]))
+        fail("render: albedo detail: hair luminance range [{}, {}] (expected an increasing pair)", hair_luminance[0],
+             hair_luminance[1]);
     double to_linear[256];
     for (int i = 0; i < 256; ++i) {
         const double c = i / 255.0;
@@ -201,15 +205,27 @@ std::vector<float> albedo_detail_slopes(const ImageRGBA8& image, float mean_leve
     std::vector<double> height(count);
     for (std::size_t i = 0; i < count; ++i)
         height[i] = std::clamp(std::log(luma[i] + 0.004) - std::log(mean[i] + 0.004), -0.5, 0.5);
-    std::vector<float> out(count * 2);
+    // Hair: where the local mean is dark (the scalp's hair, the brows' body;
+    // a mole, a nostril or a single hair is too small to darken the mean).
+    std::vector<double> hair(count);
+    for (std::size_t i = 0; i < count; ++i) {
+        const double t = std::clamp((mean[i] - hair_luminance[0]) / double(hair_luminance[1] - hair_luminance[0]), 0.0, 1.0);
+        hair[i] = 1.0 - t * t * (3.0 - 2.0 * t);
+    }
+    std::vector<float> out(count * 3);
     for (int r = 0; r < h; ++r)
         for (int x = 0; x < w; ++x) {
             auto at = [&](int xx, int rr) {
                 return height[std::size_t(std::clamp(rr, 0, h - 1)) * w + std::size_t(std::clamp(xx, 0, w - 1))];
             };
             const std::size_t i = std::size_t(r) * w + x;
-            out[2 * i + 0] = float(0.5 * (at(x + 1, r) - at(x - 1, r)) * w);
-            out[2 * i + 1] = float(0.5 * (at(x, r + 1) - at(x, r - 1)) * h);
+            // Where hair meets skin the height steps from hair below its
+            // mean to skin above it: a ridge on the skin's side whose slope
+            // drew a dark line along the hairline. Fade it across the edge.
+            const double fade = 1.0 - 4.0 * hair[i] * (1.0 - hair[i]);
+            out[3 * i + 0] = float(fade * 0.5 * (at(x + 1, r) - at(x - 1, r)) * w);
+            out[3 * i + 1] = float(fade * 0.5 * (at(x, r + 1) - at(x, r - 1)) * h);
+            out[3 * i + 2] = float(hair[i]);
         }
     return out;
 }

@@ -1,6 +1,7 @@
 #pragma once
 // The two tables the skin shading model samples, computed on the CPU when a
 // Renderer first draws with them (internal).
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -29,9 +30,13 @@ std::vector<std::uint8_t> pore_map(const PoreMapSpec& spec);
 // averaged at the default framing, where the base map is already about two
 // levels minified), clamped to +-0.5 (the step from skin to a dark hair
 // is a colour edge, not a cliff), and the result is its slopes (dh/du,
-// dh/dv per unit of the base UVs), width x height RG float pairs, rows
-// bottom first as the base texture is uploaded (v up). Hair strands, brow
-// hairs and lip lines, lighter than the gaps between them, stand out.
-std::vector<float> albedo_detail_slopes(const ImageRGBA8& image, float mean_levels);
+// dh/dv per unit of the base UVs), faded to 0 across the edge of hair (the
+// step from skin to hair is no relief), and third the hair mask: 1 where
+// the local mean's luminance is below hair_luminance[0], 0 above [1]
+// (smoothstep between). Width x height RGB float triples, rows bottom first
+// as the base texture is uploaded (v up). Hair strands, brow hairs and lip
+// lines, lighter than the gaps between them, stand out.
+std::vector<float> albedo_detail_slopes(const ImageRGBA8& image, float mean_levels,
+                                        std::array<float, 2> hair_luminance);
 
 }  // namespace emoface::render::detail

@@ -91,6 +91,22 @@ SkinShading load_skin_shading(const std::string& path) {
         s.albedo_bump_bias = float(detail.number_in("mip_bias", 0.5, 8.0));
         detail.finish();
 
+        JsonReader hair = root.object("hair");
+        const auto lum = hair.numbers<2>("mean_luminance");
+        if (!(lum[0] >= 0.0 && lum[0] < lum[1] && lum[1] <= 1.0))
+            hair.at("mean_luminance").fail("an increasing pair in [0, 1]");
+        s.hair_luminance = {float(lum[0]), float(lum[1])};
+        s.hair_wrap = float(hair.number_in("wrap", 0.0, 1.0));
+        s.hair_roughness = float(hair.number_in("roughness", 0.01, 1.0));
+        s.hair_sheen = float(hair.number_in("sheen", 0.0, 1.0));
+        hair.finish();
+
+        JsonReader wet = root.object("wet");
+        s.wet_f0 = float(wet.number_in("f0", 0.0, 1.0));
+        s.wet_broad_roughness = float(wet.number_in("broad_roughness", 0.01, 1.0));
+        s.wet_broad_weight = float(wet.number_in("broad_weight", 0.0, 1.0));
+        wet.finish();
+
         JsonReader rig = root.object("light_rig");
         s.key_tint = colour_at(rig, "key_tint");
         s.softness = float(rig.number_in("softness", 0.0, 1.0));

@@ -129,6 +129,20 @@ struct SkinShading {
     float albedo_bump_mm = 0.5f;   // height per unit of log-luminance contrast
     float albedo_bump_bias = 2.0f;  // the mean's extent, in mip levels (skin_maps.h)
 
+    // --- hair: where the base colour's local mean is dark (skin_maps.h) ---
+    // Hair does not scatter light like skin (no red terminator) and its
+    // sheen is broad and dim, not skin's.
+    std::array<float, 2> hair_luminance{0.06f, 0.13f};  // linear mean luminance: all hair .. all skin
+    float hair_wrap = 0.05f;       // N.L wrap of the rig lights on hair (skin: softness)
+    float hair_roughness = 0.7f;   // one GGX roughness for both lobes
+    float hair_sheen = 0.35f;      // the lights' sheen on hair, of skin's full sheen
+
+    // --- wet parts (the eyes, the mouth's inside): a tight lobe of the
+    // material's shininess plus a weak broad one (a moist film) ---
+    float wet_f0 = 0.025f;
+    float wet_broad_roughness = 0.45f;
+    float wet_broad_weight = 0.1f;
+
     // --- light rig (the key light is the draw's Light, tinted) ---
     glm::vec3 key_tint{1.06f, 0.98f, 0.88f};
     float softness = 0.2f;  // wrap of every rig light's N.L (soft boxes), energy kept
@@ -150,7 +164,10 @@ struct SkinShading {
                occlusion_specular == o.occlusion_specular && key_tint == o.key_tint &&
                softness == o.softness && pores == o.pores && pore_tiles == o.pore_tiles &&
                pore_strength == o.pore_strength && albedo_bump_mm == o.albedo_bump_mm &&
-               albedo_bump_bias == o.albedo_bump_bias && fill == o.fill && rim == o.rim &&
+               albedo_bump_bias == o.albedo_bump_bias && hair_luminance == o.hair_luminance &&
+               hair_wrap == o.hair_wrap && hair_roughness == o.hair_roughness && hair_sheen == o.hair_sheen &&
+               wet_f0 == o.wet_f0 && wet_broad_roughness == o.wet_broad_roughness &&
+               wet_broad_weight == o.wet_broad_weight && fill == o.fill && rim == o.rim &&
                sky == o.sky && ground == o.ground && exposure == o.exposure &&
                tone_mapping == o.tone_mapping;
     }
