@@ -112,6 +112,9 @@ double fap_scale(const ex::FapRanges& r, int n, double step) {
 constexpr double kCorrectiveTolerance = 0.004;
 constexpr double kCorrectiveNegligible = 0.0004;
 constexpr int kMaxCorrectives = 128;
+// A target's vertex that moves less than this many ES0 (a hundredth of a
+// millimetre on the default face) is not stored.
+constexpr double kUnmoved = 1e-4;
 
 void export_gltf(const ExportArgs& a) {
     if (!ends_with(a.out, ".glb")) fail<InputError>("export: --out {}: expected a file ending in .glb", a.out);
@@ -160,6 +163,8 @@ void export_gltf(const ExportArgs& a) {
     for (int v = 0; v < nv; ++v)
         for (int c = 0; c < 3; ++c) base[3 * v + c] = neutral.positions[v][c];
     const double es0 = face.fapu.es * 1024;
+    // A vertex a target moves less than this is stored as unmoved.
+    const float unmoved = static_cast<float>(kUnmoved * es0);
 
     // The rig's non-rigid stages (point field, lids, slides, lashes, pupils)
     // for a frame: what the morph targets carry; the jaw, eyes and head are
@@ -244,6 +249,11 @@ void export_gltf(const ExportArgs& a) {
             largest = std::max(largest, std::abs(double(d[i])));
         }
         if (largest < 1e-6 * es0) continue;  // a purely rigid FAP: the joints carry it
+        // The kernels' far tails are left out of the stored target (the
+        // correctives take up what that leaves at the exported frames).
+        for (int v = 0; v < nv; ++v)
+            if (std::max({std::abs(d[3 * v]), std::abs(d[3 * v + 1]), std::abs(d[3 * v + 2])}) <= unmoved)
+                d[3 * v] = d[3 * v + 1] = d[3 * v + 2] = 0.0f;
         target_of_fap[n] = static_cast<int>(names.size());
         names.push_back(fmt::format("FAP{}_{}", n, emoface::fap::fap_info(n).name));
         deltas.push_back(std::move(d));
@@ -370,9 +380,8 @@ void export_gltf(const ExportArgs& a) {
         }
     }
     // Sparse: a target stores only the vertices it moves (most move a small
-    // region), anything under a millionth of ES0 counted as unmoved.
-    for (const auto& d : deltas)
-        prim.targets.push_back({{"POSITION", gltf::add_sparse_vec3(m, d, static_cast<float>(1e-6 * es0))}});
+    // region).
+    for (const auto& d : deltas) prim.targets.push_back({{"POSITION", gltf::add_sparse_vec3(m, d, unmoved)}});
 
     // Skinning: the rig blends the jaw and the head into each vertex with its
     // own weight (rig_kernel.h blend_rigid: p + w (M p - p)), which is linear
@@ -591,10 +600,11 @@ void export_gltf(const ExportArgs& a) {
     if (!writer.WriteGltfSceneToFile(&m, out.path(), true, true, false, true))
         fail<emoface::InputError>("export: cannot write {}", a.out);
     out.commit();
-    fmt::print("{} -> {} ({} vertices, {} morph targets ({} FAPs, {} correctives: worst vertex {:.4f} ES0 off the "
-               "rig before skinning), {} wrinkle keys, {} animation frames)\n",
+    fmt::print("{} -> {} ({} vertices, {} morph targets ({} FAPs, {} correctives: the worst vertex {:.4f} ES0 off "
+               "the rig before skinning, {:.4f} without them), {} wrinkle keys, {} animation frames)\n",
                a.animation.empty() ? (a.mix.empty() ? "neutral" : a.mix) : a.animation, a.out, nv, names.size(),
                fap_targets, names.size() - first_corrective, correctives.worst_left / es0,
+               correctives.worst_before / es0,
                wrinkle_keys.key_names.size(), frames.size());
 }
 

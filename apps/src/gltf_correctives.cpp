@@ -36,6 +36,7 @@ Correctives fit_correctives(const std::vector<int>& vertices, std::vector<std::v
         });
         const auto worst = std::max_element(off.begin(), off.end());
         out.worst_left = worst == off.end() ? 0.0 : *worst;
+        if (out.targets.empty()) out.worst_before = out.worst_left;
         if (out.worst_left <= tolerance || static_cast<int>(out.targets.size()) >= max_targets) break;
         // The worst pose's remainder, as a unit direction.
         std::vector<double> q = r[std::size_t(worst - off.begin())];

@@ -23,7 +23,8 @@ struct Correctives {
     std::vector<std::vector<float>> targets;
     // Per pose, one weight per target.
     std::vector<std::vector<float>> weights;
-    double worst_left = 0;  // the largest vertex remainder the targets leave
+    double worst_before = 0;  // the largest vertex remainder with no corrective
+    double worst_left = 0;    // ... and what the targets leave of it
 };
 
 // `remainders[k]`: pose k's displacement that the targets must carry at
