@@ -622,7 +622,7 @@ void Renderer::draw(const DrawOptions& o, const WrinkleTexture* wrinkle_map) {
         glUniform1f(im.loc.min_curvature, k.min_curvature / k.max_curvature);
         glUniform1f(im.loc.wrap, k.softness);
         glUniform3f(im.loc.hair, k.hair_wrap, k.hair_roughness, k.hair_sheen);
-        glUniform3f(im.loc.wet, k.wet_f0, k.wet_broad_roughness, k.wet_broad_weight);
+        glUniform4f(im.loc.wet, k.wet_f0, k.wet_broad_roughness, k.wet_broad_weight, k.wet_tight_scale);
         glUniform3fv(im.loc.key_tint, 1, glm::value_ptr(k.key_tint));
         glUniform3fv(im.loc.fill_direction, 1, glm::value_ptr(k.fill.direction));
         glUniform3fv(im.loc.fill_colour, 1, glm::value_ptr(k.fill.colour));

@@ -112,7 +112,7 @@ uniform vec3 u_occlusion;           // how far the baked occlusion dims: key, fi
 uniform float u_min_curvature;      // table coordinate: the flattest skin still scatters
 uniform float u_wrap;               // the rig lights' softness (wrapped N.L, energy kept)
 uniform vec3 u_hair;                // hair: wrap, roughness, the lights' sheen
-uniform vec3 u_wet;                 // eyes, mouth: F0, broad lobe's roughness, its weight
+uniform vec4 u_wet;                 // eyes, mouth: F0, broad lobe's roughness, its weight, tight lobe's scale
 uniform vec3 u_key_tint;
 uniform vec3 u_fill_direction;
 uniform vec3 u_fill_colour;
@@ -312,11 +312,12 @@ vec3 shade_skin(vec3 n_bumped, vec3 n_geo, vec3 base, float cavity, float gloss,
         s.n_g = normalize(mix(s.n, n_geo, u_normal_softening.g));
         s.n_b = normalize(mix(s.n, n_geo, u_normal_softening.b));
     } else {
-        // Eyes, mouth: wet. A tight lobe of the roughness matching the
-        // Blinn-Phong exponent (Walter et al. 2007: alpha = sqrt(2 / (s + 2)))
-        // and a weak broad one, under the tear film's Fresnel.
+        // Eyes, mouth: wet. A tight lobe, sharper than the roughness that
+        // matches the Blinn-Phong exponent (Walter et al. 2007: alpha =
+        // sqrt(2 / (s + 2))), and a weak broad one, under the tear film's
+        // Fresnel.
         float alpha = sqrt(2.0 / (u_shininess + 2.0));
-        roughness = vec2(sqrt(alpha), u_wet.y);
+        roughness = vec2(sqrt(alpha) * u_wet.w, u_wet.y);
         s.lobe_weight = 1.0 - u_wet.z;
         s.f0 = u_wet.x;
         s.n = n_bumped;
