@@ -599,6 +599,37 @@ TEST_F(SkinQuad, AlbedoReliefLeansTheNormalDownItsSlope) {
     EXPECT_LT(minus, flat_minus);
 }
 
+// Hair (a base colour whose local mean is darker than
+// SkinShading::hair_luminance) is not skin: at its terminator a grey hair
+// stays grey and dark (a little wrap), where skin's wrap and scattering
+// carry light past it.
+TEST_F(SkinQuad, HairIsLitWithoutSkinsScatteringAtItsTerminator) {
+    SkinShading skin = dark_rig();
+    skin.pore_strength = 0.0f;
+    skin.key_tint = glm::vec3(1.0f);
+    Material m;
+    auto base = std::make_shared<ImageRGBA8>(16, 16);
+    for (int y = 0; y < 16; ++y)
+        for (int x = 0; x < 16; ++x) {
+            std::uint8_t* p = base->at(x, y);
+            p[0] = p[1] = p[2] = 60;  // linear luminance 0.045
+            p[3] = 255;
+        }
+    m.base_texture = base;
+    m.uses_wrinkle_map = true;  // a skin surface
+    Light light;
+    light.position = glm::vec4(1.0f, 0.0f, 0.0f, 0.0f);  // at the terminator
+    light.diffuse = glm::vec3(20.0f);  // bright enough for 8-bit channels to tell red from green
+    ASSERT_LT(0.045f, skin.hair_luminance[0]);
+    const glm::vec3 hair = draw(m, 0.0f, light, skin);
+    skin.hair_luminance = {0.0f, 0.001f};  // the same colour taken for skin
+    const glm::vec3 as_skin = draw(m, 0.0f, light, skin);
+    ASSERT_GT(hair.g, 0.0f);
+    ASSERT_GT(as_skin.g, 0.0f);
+    EXPECT_NEAR(hair.r, hair.g, 0.03f * hair.g) << "grey hair stays grey";
+    EXPECT_LT(hair.g, 0.5f * as_skin.g) << "hair's terminator is a Lambert one, barely wrapped";
+}
+
 // The GPU draw order: runs of kFrontFirstRun triangles nearest +z first, each
 // run whole and in its own order, every triangle kept once. Three layers of
 // two runs each are listed back (z 0), front (z 2), middle (z 1), and a

@@ -134,8 +134,8 @@ struct SkinShading {
     // sheen is broad and dim, not skin's.
     std::array<float, 2> hair_luminance{0.06f, 0.13f};  // linear mean luminance: all hair .. all skin
     float hair_wrap = 0.05f;       // N.L wrap of the rig lights on hair (skin: softness)
-    float hair_roughness = 0.7f;   // one GGX roughness for both lobes
-    float hair_sheen = 0.35f;      // the lights' sheen on hair, of skin's full sheen
+    float hair_roughness = 0.6f;   // one GGX roughness for both lobes
+    float hair_sheen = 0.5f;       // the lights' sheen on hair, of skin's full sheen
 
     // --- wet parts (the eyes, the mouth's inside): a tight lobe of the
     // material's shininess plus a weak broad one (a moist film) ---
