@@ -203,6 +203,8 @@ FaceParams read_face_params(const std::string& params_dir) {
             ridge.width = rr.number_list("width");
             ridge.height = rr.number_list("height");
             ridge.mirror = rr.boolean("mirror", false);
+            ridge.apex_round = rr.number("apex_round", 0.0);
+            if (ridge.apex_round < 0) rr.at("apex_round").fail("a length of 0 mm or more");
             const std::string per_point = fmt::format("{} values (one per point)", ridge.points.size());
             if (ridge.width.size() != ridge.points.size()) rr.at("width").fail(per_point);
             if (ridge.height.size() != ridge.points.size()) rr.at("height").fail(per_point);

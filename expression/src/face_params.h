@@ -61,6 +61,7 @@ struct Ridge {
     std::vector<glm::dvec2> points;
     std::vector<double> width;
     std::vector<double> height;
+    double apex_round = 0.0;  // mm over which the crest is rounded (0: the profile's own point)
     bool mirror = false;
 };
 

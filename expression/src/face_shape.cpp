@@ -110,7 +110,15 @@ double ridge_value(const Ridge& r, double x, double y, double sign) {
             best_h = mix(r.height[i], r.height[i + 1], t);
         }
     }
-    const double q = best_d2 / (best_w * best_w);
+    // A rounded crest: the distance eases in over apex_round (its square
+    // root form is flat to fourth order at the crest line), and the width
+    // gives back what that takes, so the footprint stays where it was. A
+    // tall, narrow ridge (the nose) otherwise has a crest of about 1 mm
+    // radius, which shades as a seam down the midline.
+    const double a = std::min(r.apex_round, 0.5 * best_w);
+    const double d = a > 0 ? std::sqrt(best_d2 + a * a) - a : std::sqrt(best_d2);
+    const double w = best_w - a;
+    const double q = d * d / (w * w);
     if (q >= 1.0) return 0.0;
     const double k = 1.0 - q;
     return best_h * k * k * k;
