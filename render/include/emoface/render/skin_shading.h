@@ -101,7 +101,7 @@ struct SkinShading {
     glm::vec3 normal_softening{0.5f, 0.2f, 0.1f};
     // How much the wrinkle cavity darkens direct diffuse light (ambient light
     // is darkened fully).
-    float cavity_direct = 0.5f;
+    float cavity_direct = 0.9f;
 
     // --- specular: two GGX lobes with Fresnel ---
     float f0 = 0.028f;
