@@ -328,6 +328,8 @@ TEST_F(ConvertCli, EveryCommandReadsCapturesWithItsDataFolder) {
              {"inspect", take, "--out", path("x.png")},
              {"info", take},
              {"convert", take, path("x.fap")}}) {
+        const bool draws = args[0] == "play" || args[0] == "view" || args[0] == "inspect";
+        if (draws && !EMOFACE_DRAWS) continue;  // this build has no drawing commands
         std::vector<std::string> with_data = args;
         with_data.insert(with_data.end(), {"--data", data.string()});
         const CommandResult r = run_emoface(with_data, emoface::testing::without_display());

@@ -304,7 +304,7 @@ TEST_F(ExportCli, WrinkleKeysGoAlongWithTheirAuTargets) {
     const tinygltf::Value& extras = m.meshes.at(0).extras;
     if (!extras.Has("wrinkles")) {
         // Only a build without render/ (no drawing commands) leaves them out.
-        ASSERT_NE(run_emoface({"mix", "--help"}).exit_code, 0) << "a build with render/ exported no wrinkle keys";
+        ASSERT_FALSE(EMOFACE_DRAWS) << "a build with render/ exported no wrinkle keys";
         GTEST_SKIP() << "this build has no render module, whose key plan makes the wrinkle maps";
     }
     const tinygltf::Value& w = extras.Get("wrinkles");
