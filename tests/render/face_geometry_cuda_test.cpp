@@ -9,6 +9,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
 
 #include <glm/geometric.hpp>
 
@@ -114,49 +117,71 @@ TEST(FaceSceneGeometry, GpuByDefaultWithTheSurfaceOfTheCpuGeometry) {
     }
 }
 
+// A CUDA scene and a CPU scene of one small face on one headless platform,
+// drawn alike (thesis shading, so the pictures compare on the wrinkles and
+// the geometry alone). skip says why not, where there is no CUDA-GL interop.
+struct ScenePair {
+    explicit ScenePair(int frames_in_flight) {
+        if (!cuda_geometry_available()) {
+            skip = "no CUDA device: the GPU geometry is not tested here";
+            return;
+        }
+        FaceAssetsOptions ao;
+        ao.face.resolution_scale = 0.5;
+        ao.face.texture_size = 256;
+        ao.wrinkle_map_size = 256;
+        assets = load_default_face_assets(EMOFACE_DATA_DIR, ao);
+        PlatformOptions po;
+        po.width = po.height = 160;
+        po.cuda_device = 0;
+        platform = std::make_unique<HeadlessPlatform>(po);
+        FaceSceneOptions gpu_options;
+        gpu_options.backend = morph::Backend::Cuda;
+        gpu_options.frames_in_flight = frames_in_flight;
+        gpu = make_face_scene(*platform, *assets, gpu_options);
+        if (!gpu->uses_interop()) {
+            skip = "the GL context is not on the CUDA device: no interop";
+            return;
+        }
+        FaceSceneOptions cpu_options;
+        cpu_options.backend = morph::Backend::Cpu;
+        cpu_options.frames_in_flight = frames_in_flight;  // no CUDA: the scene runs unpipelined
+        cpu = make_face_scene(*platform, *assets, cpu_options);
+        draw.camera = cpu->frontal_camera(1.0f);
+        draw.light = cpu->portrait_light();
+        draw.shading = Shading::Thesis;
+        // Every key at once, so the morph writes wrinkles everywhere it can.
+        weights.assign(std::size_t(gpu->key_count()), 1.0f / float(gpu->key_count()));
+    }
+    ImageRGBA8 render(FaceScene& scene) {
+        platform->begin_frame();
+        scene.draw(draw);
+        platform->end_frame();
+        return platform->read_rgba();
+    }
+    std::string skip;
+    std::unique_ptr<FaceAssets> assets;
+    std::unique_ptr<HeadlessPlatform> platform;
+    std::unique_ptr<FaceScene> gpu, cpu;
+    DrawOptions draw;
+    std::vector<float> weights;
+};
+
 // update() on a CUDA scene maps the wrinkle texture and the vertex buffers
 // in one call and runs the morph and the geometry on two streams in between;
 // what it draws is what the CPU morph and geometry draw, frame after frame
 // (a wrong order between the streams and the mapping would draw stale or
 // half-written buffers).
 TEST(FaceSceneGeometry, OneMappingDrawsWhatTheCpuDraws) {
-    if (!cuda_geometry_available()) GTEST_SKIP() << "no CUDA device: the GPU geometry is not tested here";
-    FaceAssetsOptions ao;
-    ao.face.resolution_scale = 0.5;
-    ao.face.texture_size = 256;
-    ao.wrinkle_map_size = 256;
-    const auto assets = load_default_face_assets(EMOFACE_DATA_DIR, ao);
-    PlatformOptions po;
-    po.width = po.height = 160;
-    po.cuda_device = 0;
-    HeadlessPlatform platform(po);
-    FaceSceneOptions gpu_options;
-    gpu_options.backend = morph::Backend::Cuda;
-    const auto gpu = make_face_scene(platform, *assets, gpu_options);
-    if (!gpu->uses_interop()) GTEST_SKIP() << "the GL context is not on the CUDA device: no interop";
-    ASSERT_TRUE(gpu->uses_gpu_geometry());
-    FaceSceneOptions cpu_options;
-    cpu_options.backend = morph::Backend::Cpu;
-    const auto cpu = make_face_scene(platform, *assets, cpu_options);
-
-    DrawOptions draw;
-    draw.camera = cpu->frontal_camera(1.0f);
-    draw.light = cpu->portrait_light();
-    draw.shading = Shading::Thesis;
-    auto render = [&](FaceScene& scene) {
-        platform.begin_frame();
-        scene.draw(draw);
-        platform.end_frame();
-        return platform.read_rgba();
-    };
-    // Every key at once, so the morph writes wrinkles everywhere it can.
-    const std::vector<float> weights(std::size_t(gpu->key_count()), 1.0f / float(gpu->key_count()));
+    ScenePair s(1);
+    if (!s.skip.empty()) GTEST_SKIP() << s.skip;
+    ASSERT_TRUE(s.gpu->uses_gpu_geometry());
     ImageRGBA8 previous;
     for (const NamedFaps& named : frames()) {
-        gpu->update(named.faps, weights);
-        const ImageRGBA8 g = render(*gpu);
-        cpu->update(named.faps, weights);
-        const ImageRGBA8 c = render(*cpu);
+        s.gpu->update(named.faps, s.weights);
+        const ImageRGBA8 g = s.render(*s.gpu);
+        s.cpu->update(named.faps, s.weights);
+        const ImageRGBA8 c = s.render(*s.cpu);
         EXPECT_GE(diff_images(g, c).psnr(), 40.0) << named.name;
         if (!previous.pixels.empty() && named.name != "neutral")
             EXPECT_LT(diff_images(g, previous).psnr(), 60.0) << named.name << ": the frame did not change";
@@ -170,55 +195,26 @@ TEST(FaceSceneGeometry, OneMappingDrawsWhatTheCpuDraws) {
 // the unmapping after the draw and the swap would draw the frame in flight,
 // a stale one or half-written buffers); flush_pipeline() lands the last.
 TEST(FaceSceneGeometry, PipelinedDrawsWhatTheCpuDrawsAFrameLater) {
-    if (!cuda_geometry_available()) GTEST_SKIP() << "no CUDA device: the GPU geometry is not tested here";
-    FaceAssetsOptions ao;
-    ao.face.resolution_scale = 0.5;
-    ao.face.texture_size = 256;
-    ao.wrinkle_map_size = 256;
-    const auto assets = load_default_face_assets(EMOFACE_DATA_DIR, ao);
-    PlatformOptions po;
-    po.width = po.height = 160;
-    po.cuda_device = 0;
-    HeadlessPlatform platform(po);
-    FaceSceneOptions gpu_options;
-    gpu_options.backend = morph::Backend::Cuda;
-    gpu_options.frames_in_flight = 2;
-    const auto gpu = make_face_scene(platform, *assets, gpu_options);
-    if (!gpu->uses_interop()) GTEST_SKIP() << "the GL context is not on the CUDA device: no interop";
-    ASSERT_EQ(gpu->frames_in_flight(), 2);
-    FaceSceneOptions cpu_options;
-    cpu_options.backend = morph::Backend::Cpu;
-    cpu_options.frames_in_flight = 2;  // no CUDA: the scene runs unpipelined
-    const auto cpu = make_face_scene(platform, *assets, cpu_options);
-    ASSERT_EQ(cpu->frames_in_flight(), 1);
-
-    DrawOptions draw;
-    draw.camera = cpu->frontal_camera(1.0f);
-    draw.light = cpu->portrait_light();
-    draw.shading = Shading::Thesis;
-    auto render = [&](FaceScene& scene) {
-        platform.begin_frame();
-        scene.draw(draw);
-        platform.end_frame();
-        return platform.read_rgba();
-    };
-    const std::vector<float> weights(std::size_t(gpu->key_count()), 1.0f / float(gpu->key_count()));
+    ScenePair s(2);
+    if (!s.skip.empty()) GTEST_SKIP() << s.skip;
+    ASSERT_EQ(s.gpu->frames_in_flight(), 2);
+    ASSERT_EQ(s.cpu->frames_in_flight(), 1);
     // Frame 0 draws the scene's first state (neutral, the first key alone).
     ImageRGBA8 previous;
     int compared = 0;
     for (const NamedFaps& named : frames()) {
-        gpu->update(named.faps, weights);
-        const ImageRGBA8 g = render(*gpu);
-        const ImageRGBA8 c = render(*cpu);  // the CPU scene still at the frame before
+        s.gpu->update(named.faps, s.weights);
+        const ImageRGBA8 g = s.render(*s.gpu);
+        const ImageRGBA8 c = s.render(*s.cpu);  // the CPU scene still at the frame before
         EXPECT_GE(diff_images(g, c).psnr(), 40.0) << "the frame before " << named.name;
         if (!previous.pixels.empty() && compared > 1)
             EXPECT_LT(diff_images(g, previous).psnr(), 60.0) << "the frame before " << named.name << " did not change";
         previous = g;
-        cpu->update(named.faps, weights);
+        s.cpu->update(named.faps, s.weights);
         ++compared;
     }
-    gpu->flush_pipeline();
-    EXPECT_GE(diff_images(render(*gpu), render(*cpu)).psnr(), 40.0) << "the last frame, flushed";
+    s.gpu->flush_pipeline();
+    EXPECT_GE(diff_images(s.render(*s.gpu), s.render(*s.cpu)).psnr(), 40.0) << "the last frame, flushed";
     EXPECT_GT(compared, 2);
 }
 
