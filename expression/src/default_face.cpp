@@ -588,11 +588,13 @@ void Generator::build_mouth_interior(Face& face) {
         const int rings = 10, segs = 36;
         auto part_of = [&](double y) { return y >= cc.y ? VertexPart::MouthUpper : VertexPart::MouthLower; };
         auto uv = [&](double g, double s, double& u, double& v) {
-            // The cavity's mucosa is a dark red throughout (the tile's rim);
-            // its darkening with depth is the renderer's occlusion, baked for
-            // the interior (face_scene.cpp bake_occlusion), so it lightens
-            // where the lips part instead of staying black.
-            const double rr = 0.48 * (0.8 + 0.2 * g / (0.5 * kPi));
+            // The cavity's mucosa is a dark red (the tile's rim), darker
+            // towards the back wall (the tile's centre) on top of the
+            // renderer's occlusion, baked for the interior (face_scene.cpp
+            // bake_occlusion), which lightens it where the lips part: the
+            // occlusion alone left the back wall lit like the lips, a
+            // shallow mouth.
+            const double rr = 0.48 * (0.25 + 0.75 * g / (0.5 * kPi));
             u = detail::tile_u0(Tile::Cavity) + detail::kTile * (0.5 + rr * std::cos(s));
             v = detail::kTile * (0.5 + rr * std::sin(s));
         };

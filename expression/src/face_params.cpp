@@ -273,6 +273,10 @@ FaceParams read_face_params(const std::string& params_dir) {
             p.brow_hair_length = to_glm(h.numbers<2>("length"));
             p.brow_medial_angle = h.number_in("medial_angle_deg", 0.0, 120.0);
             p.brow_lateral_angle = h.number_in("lateral_angle_deg", 0.0, 60.0);
+            p.brow_hair_bend = h.number_in("bend_mm", 0.0, 5.0);
+            p.brow_hair_tone = to_glm(h.numbers<2>("tone"));
+            if (!(p.brow_hair_tone[0] > 0.0 && p.brow_hair_tone[0] <= p.brow_hair_tone[1] && p.brow_hair_tone[1] <= 3.0))
+                h.at("tone").fail("an increasing pair of factors in (0, 3]");
             h.finish();
             r.finish();
         }
@@ -348,6 +352,7 @@ FaceParams read_face_params(const std::string& params_dir) {
             tint(r.object("periorbital"), &a.periorbital_tint, &a.periorbital_amount);
             a.lip_border_mm = r.number_in("lip_border_mm", 0.05, 5.0);
             a.lip_lines = r.number_in("lip_lines", 0.0, 1.0);
+            a.lip_sheen_breakup = r.number_in("lip_sheen_breakup", 0.0, 1.0);
             a.lid_margin = colour(r, "lid_margin");
             {
                 JsonReader h = r.object("hairline");

@@ -208,6 +208,10 @@ struct FaceParams {
     double brow_hair_spacing = 0.0, brow_hair_width = 0.0;
     glm::dvec2 brow_hair_length{0.0};
     double brow_medial_angle = 0.0, brow_lateral_angle = 0.0;
+    // How far a long hair's tip curves off its straight line (mm); the
+    // range of the hairs' tones as factors of the brows' colour.
+    double brow_hair_bend = 0.0;
+    glm::dvec2 brow_hair_tone{1.0};
 
     // albedo variation of the skin (face.json "albedo"; mm, fractions)
     struct Flush {
@@ -229,6 +233,8 @@ struct FaceParams {
         glm::dvec3 beard_tint{1.0}, forehead_tint{1.0}, periorbital_tint{1.0};
         double beard_amount = 0.0, forehead_amount = 0.0, periorbital_amount = 0.0;
         double lip_border_mm = 0.0, lip_lines = 0.0;
+        // 0 (one even gloss over the lips) .. 1: how far their sheen is broken up.
+        double lip_sheen_breakup = 0.0;
         glm::dvec3 lid_margin{0.0};
         // Single fine hairs at the hairline (face_texture.cpp).
         struct FineHairs {

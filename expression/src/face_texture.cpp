@@ -34,9 +34,12 @@ struct Texel {
 };
 
 // One brow hair: a stroke from its root along `dir` (unit, frontal x/y mm).
+// `side` is the unit normal of `dir` the hair curves towards, `bend` how far
+// its tip lies off the straight line (mm): the centre line is root +
+// t length dir + t^2 bend side, t 0 .. 1.
 struct BrowHair {
-    glm::dvec2 root, dir;
-    double length, width, shade;
+    glm::dvec2 root, dir, side;
+    double length, width, shade, bend;
 };
 
 class Painter {
@@ -110,7 +113,7 @@ double Painter::brow_density(const BrowPlace& b) const {
     // Feathered edges: fewer hairs towards the brow's upper and lower rims,
     // so its outline is the hairs' own and not a drawn shape.
     double d = 1.0 - glm::smoothstep(0.35, 1.3, q);
-    d *= 0.4 + 0.6 * glm::smoothstep(0.0, 0.3, b.t);   // sparse at the inner end
+    d *= 0.55 + 0.45 * glm::smoothstep(0.0, 0.3, b.t);  // sparser at the inner end
     d *= 1.0 - 0.7 * glm::smoothstep(0.6, 1.0, b.t);   // and thinning to the tail
     return d;
 }
@@ -143,16 +146,44 @@ Painter::Painter(const FaceShape& shape) : s_(shape), p_(shape.params()) {
                 const double side_tilt = -lateral * std::clamp(b.above / b.half, -1.0, 1.0);
                 const double lateral_angle = side_tilt + 0.25 * (hash(i, j, 43 + side) - 0.5);
                 const double w = glm::smoothstep(0.08, 0.32, b.t);
-                const double angle = mix(medial + 0.3 * (hash(i, j, 47 + side) - 0.5), lateral_angle, w);
+                // The medial hairs fan: the lowest stand upright, those
+                // higher up lean outward, each a little its own way.
+                const double fan = 0.35 * std::clamp(b.above / b.half, -1.0, 1.0);
+                const double angle = mix(medial - fan + 0.45 * (hash(i, j, 47 + side) - 0.5), lateral_angle, w);
                 glm::dvec2 dir = std::cos(angle) * along + std::sin(angle) * up;
                 dir = glm::normalize(dir);
                 BrowHair h;
                 h.dir = dir;
                 h.length = mix(p_.brow_hair_length[0], p_.brow_hair_length[1], w) * (0.75 + 0.5 * hash(i, j, 53 + side));
-                // Roots sit back along the hair so its middle lies where it was drawn.
-                h.root = glm::dvec2{sx * jx, jy} - 0.45 * h.length * dir;
+                // Hairs curve as they grow: the medial ones outward, the
+                // lateral ones towards the line (those above it down, those
+                // below up), most at the tail, where they follow the arch down.
+                glm::dvec2 normal{-dir[1], dir[0]};
+                const glm::dvec2 towards = w < 0.5 ? along : (b.above > 0.0 || b.t > 0.8 ? -up : up);
+                if (glm::dot(normal, towards) < 0.0) normal = -normal;
+                h.side = normal;
+                h.bend = p_.brow_hair_bend * (0.4 + 0.6 * hash(i, j, 67 + side)) * (0.5 + 0.5 * w) * h.length /
+                         p_.brow_hair_length[1];
+                // Roots sit back along the hair, so the stroke covers where
+                // it was drawn; a hair whose tip would leave the brow is cut
+                // short (the medial hairs grew down past the brow's lower
+                // edge, a fringe of strokes under it).
+                h.root = glm::dvec2{sx * jx, jy} - 0.3 * h.length * dir;
+                const BrowPlace rb = brow_place(h.root[0], h.root[1]);
+                if (rb.distance > 1.2 * rb.half || (rb.t <= 0.0 && rb.distance > 0.3 * rb.half)) continue;
+                for (int k = 0; k < 4; ++k) {
+                    const glm::dvec2 tip = h.root + h.length * dir + h.bend * h.side;
+                    const BrowPlace tb = brow_place(tip[0], tip[1]);
+                    if (tb.distance < 1.15 * tb.half && tb.t > 0.0) break;
+                    h.length *= 0.75;
+                    h.bend *= 0.75;
+                }
                 h.width = p_.brow_hair_width * (0.8 + 0.4 * hash(i, j, 59 + side));
-                h.shade = 0.7 + 0.6 * hash(i, j, 61 + side);
+                // Tones differ hair to hair: most a little darker or lighter
+                // than the brows' colour, a few much lighter (fair hairs
+                // catch the light) or darker.
+                const double tone = hash(i, j, 61 + side);
+                h.shade = mix(p_.brow_hair_tone[0], p_.brow_hair_tone[1], tone * tone * (3.0 - 2.0 * tone));
                 hairs_.push_back(h);
             }
         }
@@ -163,8 +194,8 @@ Painter::Painter(const FaceShape& shape) : s_(shape), p_(shape.params()) {
     grid_.assign(static_cast<std::size_t>(grid_w_) * grid_h_, {});
     for (int k = 0; k < static_cast<int>(hairs_.size()); ++k) {
         const BrowHair& h = hairs_[static_cast<std::size_t>(k)];
-        const glm::dvec2 tip = h.root + h.length * h.dir;
-        const double r = h.width + 0.5;
+        const glm::dvec2 tip = h.root + h.length * h.dir + h.bend * h.side;
+        const double r = h.width + 0.5 + std::abs(h.bend);
         const int gx0 = static_cast<int>(std::floor((std::min(h.root[0], tip[0]) - r - grid_min_[0]) / kBucket));
         const int gx1 = static_cast<int>(std::floor((std::max(h.root[0], tip[0]) + r - grid_min_[0]) / kBucket));
         const int gy0 = static_cast<int>(std::floor((std::min(h.root[1], tip[1]) - r - grid_min_[1]) / kBucket));
@@ -188,7 +219,7 @@ double Painter::brow_hairs(double x, double y, Rgb* colour) const {
         const glm::dvec2 rel = glm::dvec2{x, y} - h.root;
         const double along = glm::dot(rel, h.dir) / h.length;
         if (along < -0.05 || along > 1.05) continue;
-        const double across = std::abs(rel[0] * h.dir[1] - rel[1] * h.dir[0]);
+        const double across = std::abs(glm::dot(rel, h.side) - h.bend * along * along);
         // Tapering to the tip; the edge softened over about a texel so thin
         // hairs stay continuous strokes in the texture.
         const double half = 0.5 * h.width * (1.0 - 0.55 * std::clamp(along, 0.0, 1.0));
@@ -432,28 +463,51 @@ Texel Painter::skin(glm::dvec3 q) const {
         const double t_zone = std::max(field(q.x, q.y, 0.0, 40.0, 22.0, 18.0), field(q.x, q.y, 0.0, -20.0, 9.0, 24.0));
         gloss = mix(1.0, p_.gloss.t_zone, std::min(t_zone, 1.0));
 
-        // Lips: the vermilion fades into the skin over the border's width,
-        // a little lighter just outside it (the white roll), with fine
-        // vertical lines.
+        // Lips: the vermilion fades into the skin over the border's width
+        // (its course wanders a little: a drawn curve reads as lipstick), a
+        // little lighter just outside it (the white roll). Darker towards
+        // the line where the lips meet and on the upper lip, lighter on the
+        // lower lip's centre (it faces the light and is fuller), fading
+        // towards the skin's tone at the corners, with fine vertical lines.
         const double hw = s_.mouth_half_width();
         if (ax < hw + 4.0 && q.z > 60.0) {
             const double up = s_.upper_border(q.x), lo = s_.lower_border(q.x);
-            const double inside = std::min({up - q.y, q.y - lo, (hw - ax) * 0.6});
+            const double wander = 0.35 * (noise(q.x * 0.6, q.y * 0.6, 3.0) - 0.5);
+            const double inside = std::min({up - q.y, q.y - lo, (hw - ax) * 0.6}) + wander;
             const double border = al.lip_border_mm;
-            const double m = glm::smoothstep(-0.45 * border, 0.55 * border, inside);
-            const double roll = (1.0 - glm::smoothstep(0.0, 1.2, std::abs(inside + 0.6 * border))) *
-                                (q.y > s_.mouth_line(q.x) ? 1.0 : 0.4);
+            const double m = glm::smoothstep(-0.5 * border, 0.8 * border, inside);
+            const double line_y = s_.mouth_line(q.x);
+            const bool upper = q.y > line_y;
+            const double roll = (1.0 - glm::smoothstep(0.0, 1.2, std::abs(inside + 0.6 * border))) * (upper ? 1.0 : 0.4);
             c = blend(c, c * 1.06, 0.5 * roll * (1.0 - m));
             if (m > 0) {
-                const double crease = glm::smoothstep(0.0, 2.0, std::abs(q.y - s_.mouth_line(q.x)));
-                // Lines run across the lip (vertically), meandering; deepest mid-lip.
-                const double lx = q.x * 1.25 + 0.6 * std::sin(q.y * 0.9 + q.x * 0.2);
-                const double groove = std::pow(std::abs(std::sin(kPi * lx)), 6.0) * (0.5 + noise(q.x * 0.8, q.y * 0.3, 2.0));
-                const double mid = glm::smoothstep(0.2, 1.5, inside) * (0.4 + 0.6 * crease);
-                Rgb lips = from255(p_.lips) * (0.84 + 0.16 * crease) * (0.95 + 0.1 * noise(q.x * 2.5, q.y * 0.6, 1.0));
-                lips = lips * (1.0 - al.lip_lines * 0.35 * groove * mid);
+                const double to_line = std::abs(q.y - line_y);
+                const double crease = glm::smoothstep(0.0, 2.5, to_line);
+                // Lines run across the lip, fanning out from the mouth line,
+                // unevenly spaced (each column its own phase and depth),
+                // meandering; deepest mid-lip, gone at the border and the line.
+                const double lx = q.x * 1.1 + 0.5 * std::sin(q.y * 0.9 + q.x * 0.2) + 0.8 * (noise(q.x * 0.3, q.y * 0.5, 5.0) - 0.5);
+                const int column = static_cast<int>(std::floor(lx));
+                const double f = lx - column - 0.5 * (hash(column, upper ? 1 : 2, 201) - 0.5);
+                const double groove = std::exp(-std::pow((f - 0.5) / 0.16, 2)) * (0.4 + 0.9 * hash(column, upper ? 1 : 2, 203)) *
+                                      (0.5 + noise(q.x * 0.8, q.y * 0.4, 2.0));
+                const double mid = glm::smoothstep(0.2, 1.5, inside) * (0.3 + 0.7 * crease);
+                const double fullness = field(q.x, q.y, 0.0, mix(line_y, lo, 0.45), 9.0, 2.6);
+                Rgb lips = from255(p_.lips) * (0.78 + 0.22 * crease) * (upper ? 0.93 : 1.0) * (1.0 + 0.1 * fullness) *
+                           (0.94 + 0.12 * noise(q.x * 1.3, q.y * 0.9, 1.0));
+                lips = blend(lips, c * Rgb{0.95, 0.9, 0.9}, 0.45 * glm::smoothstep(0.55 * hw, hw, ax));
+                // Grooves darker, the ridges between them a shade lighter:
+                // the relief map raises the ridges, breaking the sheen.
+                lips = lips * (1.0 + al.lip_lines * mid * (0.06 - 0.4 * groove));
                 c = blend(c, lips, m);
-                gloss = mix(gloss, p_.gloss.lips, m);
+                // The sheen: moist where the lips meet, drier towards the
+                // border, in patches, and dull in the grooves; one even gloss
+                // over the vermilion read as a varnish.
+                const double sheen_patches = noise(q.x * 0.45, q.y * 0.7, 9.0);
+                const double wet = 1.0 - glm::smoothstep(1.0, 3.5, to_line);
+                const double dry = al.lip_sheen_breakup * std::clamp(0.4 * (1.0 - wet) + 0.5 * glm::smoothstep(0.35, 0.8, sheen_patches) +
+                                                                         0.5 * groove * mid, 0.0, 1.0);
+                gloss = mix(gloss, mix(p_.gloss.lips, 1.0, dry), m);
             }
         }
         // Eyelids: lash roots and slightly darker lids; the lid margin's
@@ -556,11 +610,20 @@ Rgb Painter::tile(double u, double v) const {
             const double bounds[] = {0.0, 4.3, 10.6, 17.8, 24.6, 31.4, 41.0};
             double gap = 1e9;
             for (double b : bounds) gap = std::min(gap, std::abs(s - b * (upper ? 1.0 : 0.8)));
-            Rgb teeth = from255(p_.teeth) * (1.0 - 0.45 * (1.0 - glm::smoothstep(0.15, 0.5, gap)));
-            const double edge = std::min(std::abs(c - 1.0), std::abs(c - 2.0));
-            teeth = blend(teeth, teeth * Rgb{0.85, 0.87, 0.92}, 1.0 - glm::smoothstep(0.0, 0.25, edge));
-            const double gum = c < 0.25 || c > 2.75 ? 1.0 : 0.0;
-            return blend(teeth, Rgb{0.72, 0.36, 0.36}, gum);
+            // Each crown darker towards its contacts (its sides turn away
+            // and the gaps between crowns are in shadow), softly: a black
+            // seam round every crown read as a grille.
+            Rgb teeth = from255(p_.teeth) * (1.0 - 0.3 * (1.0 - glm::smoothstep(0.1, 1.2, gap)));
+            // Enamel is thin at the neck, where the yellower dentin shows,
+            // and translucent at the biting edge, grey-blue against the dark
+            // mouth behind it.
+            const double front = c <= 1.5 ? c : 3.0 - c;  // 0 gum .. 1 edge, either face
+            teeth = blend(teeth * Rgb{0.9, 0.84, 0.72}, teeth, glm::smoothstep(0.3, 0.65, front));
+            teeth = blend(teeth, teeth * Rgb{0.78, 0.82, 0.9}, glm::smoothstep(0.8, 1.0, front));
+            // The gum: pink, a darker red along its margin on the crown.
+            const double gum = 1.0 - glm::smoothstep(0.22, 0.3, front);
+            const Rgb gums{0.74, 0.4, 0.4};
+            return blend(teeth, gums * (0.85 + 0.15 * glm::smoothstep(0.1, 0.25, front)), gum);
         }
         case Tile::Tongue:
             return from255(p_.tongue) * (0.85 + 0.25 * noise(lu * 40, lv * 40, 2.0));
