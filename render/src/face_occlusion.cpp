@@ -17,6 +17,61 @@ bool is_interior(expression::VertexPart p) {
            p == expression::VertexPart::Tongue;
 }
 
+// Lashes are strands: skin pieces of a few vertices that no triangle joins to
+// the skin's surface (the rig carries them by welding). Rasterised at the
+// bake's texel (1.6 mm) a row of 0.2 mm strands turns into a solid visor over
+// the upper lid, whose shade the lid's skin then carries wherever it moves:
+// a dark band like eyeshadow over eyes opened wide. They occlude nothing.
+std::vector<char> strand_triangles(const std::vector<unsigned>& triangles, std::size_t n,
+                                   const std::vector<expression::VertexPart>& parts) {
+    constexpr std::size_t kStrandVertices = 16;
+    std::vector<unsigned> root(n);
+    for (std::size_t v = 0; v < n; ++v) root[v] = unsigned(v);
+    auto find = [&](unsigned v) {
+        while (root[v] != v) v = root[v] = root[root[v]];
+        return v;
+    };
+    for (std::size_t t = 0; t < triangles.size(); t += 3)
+        for (int k = 1; k < 3; ++k) root[find(triangles[t + std::size_t(k)])] = find(triangles[t]);
+    std::vector<std::size_t> size(n, 0);
+    for (std::size_t v = 0; v < n; ++v) ++size[find(unsigned(v))];
+    std::vector<char> strand(triangles.size() / 3, 0);
+    for (std::size_t t = 0; t < triangles.size(); t += 3) {
+        const unsigned v = triangles[t];
+        strand[t / 3] = char(size[find(v)] <= kStrandVertices &&
+                             (parts.size() != n || parts[v] == expression::VertexPart::Skin));
+    }
+    return strand;
+}
+
+// How far the skin at `p` is the upper lid's (from its margin up to the
+// brow, the inner canthus beside it included; 0..1, fading out past the eye's
+// corners and behind the eyeball's centre). `margin` is the upper margin's
+// rest polyline, `brow` the brow's inner, top and outer points.
+float upper_lid_weight(const glm::vec3& p, const std::vector<glm::vec3>& margin, const glm::vec3 (&brow)[3],
+                       const glm::vec3& centre) {
+    const glm::vec3 inner = margin.front(), outer = margin.back();
+    const float a = (p.x - inner.x) / (outer.x - inner.x);  // 0 inner corner, 1 outer
+    const float across = glm::smoothstep(-0.35f, -0.05f, a) * (1.0f - glm::smoothstep(1.0f, 1.25f, a));
+    if (across <= 0.0f) return 0.0f;
+    // Piecewise linear in x along a polyline ordered inner to outer.
+    auto height_at = [&](auto&& point, std::size_t count) {
+        const float x = p.x;
+        const float sign = outer.x > inner.x ? 1.0f : -1.0f;
+        if (sign * (x - point(0).x) <= 0.0f) return point(0).y;
+        for (std::size_t i = 1; i < count; ++i)
+            if (sign * (x - point(i).x) <= 0.0f) {
+                const glm::vec3 q0 = point(i - 1), q1 = point(i);
+                return glm::mix(q0.y, q1.y, (x - q0.x) / (q1.x - q0.x));
+            }
+        return point(count - 1).y;
+    };
+    const float lid = height_at([&](std::size_t i) { return margin[i]; }, margin.size());
+    const float top = height_at([&](std::size_t i) { return brow[i]; }, 3);
+    const float up = glm::smoothstep(-1.5f, 0.5f, p.y - lid) * (1.0f - glm::smoothstep(top - 3.0f, top + 2.0f, p.y));
+    return across * up * glm::smoothstep(centre.z - 2.0f, centre.z + 2.0f, p.z);
+}
+
 }  // namespace
 
 std::vector<float> bake_face_occlusion(const expression::TriMesh& mesh, const expression::Face& face) {
@@ -36,6 +91,14 @@ std::vector<float> bake_face_occlusion(const expression::TriMesh& mesh, const ex
         for (const auto vh : mesh.fv_range(fh))
             if (k < 3) v[k++] = unsigned(vh.idx());
         if (k == 3) triangles.insert(triangles.end(), v, v + 3);
+    }
+    {
+        const std::vector<char> strand = strand_triangles(triangles, n, face.parts);
+        std::vector<unsigned> solid;
+        solid.reserve(triangles.size());
+        for (std::size_t t = 0; t < triangles.size(); t += 3)
+            if (!strand[t / 3]) solid.insert(solid.end(), triangles.begin() + std::ptrdiff_t(t), triangles.begin() + std::ptrdiff_t(t + 3));
+        triangles.swap(solid);
     }
     std::vector<float> open = bake_vertex_occlusion(positions, normals, triangles);
 
@@ -73,6 +136,36 @@ std::vector<float> bake_face_occlusion(const expression::TriMesh& mesh, const ex
         p = glm::vec3(float(fp.position[0]), float(fp.position[1]), float(fp.position[2]));
         return true;
     };
+
+    // The upper lids keep a share of their rest shade. Their skin is the
+    // face's most mobile (AU1, 2 and 5 lift it and the brow by up to 10 mm
+    // and stretch it flat; AU4 and 43 fold it down), while the bake sees it
+    // only at rest, tucked under the brow: carried onto the raised, opened
+    // lid it drew a dark band like eyeshadow over the eyes of fear, surprise
+    // and sadness, where the brow no longer overhangs. A gentle shade stays
+    // (the lid's crease and the brow still shade it a little in every pose);
+    // the lid's shadow on the eyeball is the eye tile's (eye_texture.h).
+    constexpr float kLidShadeKept = 0.4f;
+    const char* const brow_ids[2][3] = {{"4.1", "4.3", "4.5"}, {"4.2", "4.4", "4.6"}};
+    if (parts_known)
+        for (std::size_t side = 0; side < std::min<std::size_t>(face.eyeballs.size(), 2); ++side) {
+            const auto& eb = face.eyeballs[side];
+            glm::vec3 brow[3];
+            if (eb.upper_margin.size() < 2 || !point(brow_ids[side][0], brow[0]) ||
+                !point(brow_ids[side][1], brow[1]) || !point(brow_ids[side][2], brow[2]))
+                continue;
+            std::vector<glm::vec3> margin;
+            for (const int v : eb.upper_margin) margin.push_back(positions[std::size_t(v)]);
+            // Inner corner first.
+            if (std::abs(margin.front().x) > std::abs(margin.back().x)) std::reverse(margin.begin(), margin.end());
+            const glm::vec3 centre(float(eb.centre[0]), float(eb.centre[1]), float(eb.centre[2]));
+            for (std::size_t v = 0; v < n; ++v) {
+                if (face.parts[v] != expression::VertexPart::Skin || (positions[v].x > 0.0f) != (centre.x > 0.0f))
+                    continue;
+                const float w = upper_lid_weight(positions[v], margin, brow, centre);
+                if (w > 0.0f) open[v] = glm::mix(open[v], 1.0f - kLidShadeKept * (1.0f - open[v]), w);
+            }
+        }
     glm::vec3 top, bottom, left, right, upper_border, lower_border;
     if (!parts_known || !point("2.2", top) || !point("2.3", bottom) || !point("2.4", left) || !point("2.5", right) ||
         !point("8.1", upper_border) || !point("8.2", lower_border))
