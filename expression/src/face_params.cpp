@@ -114,6 +114,10 @@ FaceParams read_face_params(const std::string& params_dir) {
             p.hair_volume.fade = hv.number_in("fade", 0.5, 60.0);
             p.hair_volume.lumps = hv.number_in("lumps", 0.0, 0.8);
             p.hair_volume.lump_size = hv.number_in("lump_mm", 2.0, 100.0);
+            p.hair_volume.tuft_size = to_glm(hv.numbers<2>("tuft_mm"));
+            if (!(p.hair_volume.tuft_size[0] >= 1.0 && p.hair_volume.tuft_size[1] >= 1.0))
+                hv.at("tuft_mm").fail("2 sizes of at least 1 mm");
+            p.hair_volume.tufts = hv.number_in("tufts", 0.0, 0.9);
             hv.finish();
             r.finish();
         }
@@ -301,6 +305,7 @@ FaceParams read_face_params(const std::string& params_dir) {
             p.hair_strand_length = r.number_in("strand_length", 0.5, 100.0);
             p.hair_tip_lightening = r.number_in("tip_lightening", 0.0, 1.0);
             p.hair_swirl = r.number_in("swirl_deg", -180.0, 180.0) * 3.14159265358979323846 / 180.0;
+            p.hair_tuft_shade = r.number_in("tuft_shade", 0.0, 0.9);
             r.finish();
         }
         {

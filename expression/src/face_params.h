@@ -105,9 +105,14 @@ struct FaceParams {
     // at the nape, and over how many mm above the hairline it grows to that; lumps: +-
     // that fraction of it in tufts about lump_size mm across, so the
     // silhouette is not one smooth shell
+    // tufts: the hair's clumps (mm across and along the strands' flow),
+    // each standing up by +- tufts of the volume on its crest and sinking
+    // into a parting between clumps
     struct HairVolume {
         double top = 0.0, sides = 0.0, nape = 0.0, fade = 1.0;
         double lumps = 0.0, lump_size = 1.0;
+        glm::dvec2 tuft_size{1.0};
+        double tufts = 0.0;
     } hair_volume;
 
     // eyes (left eye; the right one mirrors it)
@@ -202,6 +207,9 @@ struct FaceParams {
     // how far the strands turn round the crown per 100 mm from it (radians;
     // the whorl's spiral, so the front sweeps across the forehead)
     double hair_swirl = 0.0;
+    // hair: how much darker a parting between tufts is than a tuft's crest
+    // (the strands' roots show there, shadowed by the clumps beside it)
+    double hair_tuft_shade = 0.0;
     // brow hairs: spacing of their roots, length at the inner end and beyond,
     // width (mm), angle off the brow line (degrees) of the medial ones and of
     // the lateral ones above and below the line (which converge on it)

@@ -361,11 +361,13 @@ double FaceShape::ear_relief(double y, double z) const {
     // The helix: from the front top, round the top and down the back; not
     // along the front below its root, nor on the lobe.
     const double helix = (1.0 - glm::smoothstep(0.25, 0.7, s) * glm::smoothstep(0.45, 0.1, a)) * (1.0 - lobe);
-    h += helix * (0.22 * H * gauss(rim_d - 1.7, 1.4) - 0.2 * H * gauss(rim_d - 4.8, 1.7));
+    // Rim and groove are a few grid steps wide (the skin grid is about
+    // 1.4 mm here): a 1.4 mm rim sampled on it saw-toothed along the ear.
+    h += helix * (0.2 * H * gauss(rim_d - 2.4, 2.2) - 0.18 * H * gauss(rim_d - 6.2, 2.4));
     // Antihelix and its two crura, an inner ridge parallel to the rim.
     const double anti = ear_curve_distance(a, s, {{-0.55, -0.3}, {-0.1, -0.48}, {0.32, -0.42}, {0.68, 0.05}});
     const double crus = ear_curve_distance(a, s, {{0.32, -0.42}, {0.3, 0.35}});
-    h += 0.2 * H * gauss(std::min(anti, 1.1 * crus) * mm, 2.2);
+    h += 0.2 * H * gauss(std::min(anti, 1.1 * crus) * mm, 2.8);
     // Concha: a deep bowl in front of the antihelix, behind the tragus.
     const double cu = (a + 0.08) / 0.36, cv = (s - 0.2) / 0.42;
     const double bowl = std::max(0.0, 1.0 - cu * cu - cv * cv);
@@ -382,6 +384,25 @@ double FaceShape::ear_relief(double y, double z) const {
     // front joins the face.
     const double edge = 1.0 - glm::smoothstep(s > 0.6 ? 0.7 : 0.9, 1.0, rho);
     return std::max(h * edge, 0.0);
+}
+
+glm::dvec2 FaceShape::ear_rim_pull(double y, double z) const {
+    // Grid points near the ear's outline are drawn onto it (the band
+    // rho 1 +- kBand is mapped onto itself by d -> d|d|, flat at the
+    // outline), so the wall where the rim drops to the scalp runs along
+    // the outline's smooth curve instead of stepping from one grid cell to
+    // the next: a saw-tooth rim at any grid spacing.
+    constexpr double kBand = 0.16;
+    const double t = p_.ear_tilt_deg * kPi / 180.0;
+    const double dy = y - p_.ear_centre_yz[0], dz = z - p_.ear_centre_yz[1];
+    const double a = (dy * std::cos(t) - dz * std::sin(t)) / p_.ear_radii_yz[0];
+    if (a < -1.3 || a > 1.3) return {0.0, 0.0};
+    const double s = (dy * std::sin(t) + dz * std::cos(t)) / (p_.ear_radii_yz[1] * ear_width(std::clamp(a, -1.0, 1.0)));
+    const double rho = std::sqrt(a * a + s * s);
+    const double d = (rho - 1.0) / kBand;
+    if (std::abs(d) >= 1.0 || rho <= 0.0) return {0.0, 0.0};
+    const double k = (1.0 + kBand * d * std::abs(d)) / rho;
+    return ear_point(a * k, s * k) - glm::dvec2{y, z};
 }
 
 double FaceShape::hairline(glm::dvec3 q) const {
@@ -415,19 +436,74 @@ double FaceShape::hairline(glm::dvec3 q) const {
     return line + p_.hairline_wander * 2.0 * (wander - 0.5);
 }
 
+double FaceShape::hair_height(glm::dvec3 q) const {
+    // The line's slope over the head (across x and z, at about 3 mm so the
+    // wander's finest wiggles do not decide it).
+    constexpr double h = 1.5;
+    const double lx = (hairline(q + glm::dvec3{h, 0.0, 0.0}) - hairline(q - glm::dvec3{h, 0.0, 0.0})) / (2.0 * h);
+    const double lz = (hairline(q + glm::dvec3{0.0, 0.0, h}) - hairline(q - glm::dvec3{0.0, 0.0, h})) / (2.0 * h);
+    return (q.y - hairline(q)) / std::sqrt(1.0 + lx * lx + lz * lz);
+}
+
+FaceShape::HairFlow FaceShape::hair_flow(glm::dvec3 q) const {
+    // Strand coordinates round the crown. The azimuth's wrap (+-pi) lies
+    // behind and below the crown, on the nape, where no view of the face
+    // sees the seam it makes in the strands.
+    const glm::dvec3 rel = q - p_.hair_crown;
+    const double along = glm::length(rel);
+    const glm::dvec3 axis = glm::normalize(p_.hair_crown);
+    const glm::dvec3 e1 = -glm::normalize(glm::cross(axis, glm::dvec3{1.0, 0.0, 0.0}));
+    const glm::dvec3 e2 = glm::cross(axis, e1);
+    // The whorl's spiral: strands turn round the crown with distance, most
+    // over the front (the hair sweeps across the forehead instead of
+    // falling straight onto it as a fringe) and not at all at the nape,
+    // so the azimuth's wrap stays there.
+    const double straight = std::atan2(glm::dot(rel, e2), glm::dot(rel, e1));
+    const double facing = std::cos(0.5 * straight);
+    const double azimuth = straight + p_.hair_swirl * (along / 100.0) * facing * facing;
+    // Across in mm at a typical distance; fanning out with distance is the whorl.
+    return {azimuth, azimuth * 70.0, along};
+}
+
+double FaceShape::hair_tuft(glm::dvec3 q) const {
+    const glm::dvec2 size = p_.hair_volume.tuft_size;
+    const HairFlow f = hair_flow(q);
+    // Lanes across the flow whose course sways as they run, so the partings
+    // are not parallel grooves.
+    const double sway = 0.9 * size.x * (noise(f.across / (2.5 * size.x), f.along / 30.0, 31.0) - 0.5);
+    const double u = (f.across + sway) / size.x;
+    const int i = static_cast<int>(std::floor(u));
+    // Each lane's tufts start where its neighbours' are half grown: shingles.
+    const double v = f.along / size.y + hash(i, 3, 71);
+    const int j = static_cast<int>(std::floor(v));
+    const double fu = u - i, fv = v - j;
+    // Across: round-topped, down to the parting at the lane's edges. Along:
+    // a tuft swells from its root and thins to its tip over the next one's
+    // root, gently enough that the head's 5 mm rows over the crown
+    // (face.json resolution) follow it without facets; both profiles are 0
+    // where the next lane or tuft begins, so the tufts' own strengths join
+    // without a step.
+    const double across = std::pow(std::sin(kPi * fu), 0.7);
+    const double along = glm::smoothstep(0.0, 0.55, fv) * glm::smoothstep(1.0, 0.6, fv);
+    return across * (0.35 + 0.65 * along * (0.55 + 0.45 * hash(i, j, 73)));
+}
+
 double FaceShape::hair_thickness(glm::dvec3 base, glm::dvec3 n) const {
     const FaceParams::HairVolume& v = p_.hair_volume;
-    const double above = base.y - hairline(base);
+    const double above = hair_height(base);
     if (above <= 0.0) return 0.0;
     // A short haircut: fullest over the crown, close on the sides and
-    // thinning down the nape; it rises from the hairline over `fade` mm.
+    // thinning down the nape; it rises from nothing at the hairline over
+    // `fade` mm, so no ledge stands there.
     const double side = std::abs(n.x);
     double t = mix(v.top, v.sides, glm::smoothstep(0.35, 0.9, side));
     t = mix(v.nape, t, glm::smoothstep(-60.0, 20.0, base.y));
-    // Tufts: the volume swells and dips by +-lumps, so the silhouette is
-    // a haircut's and not a helmet's smooth shell.
+    // Broad lumps: the volume swells and dips by +-lumps.
     const glm::dvec3 l = base / v.lump_size;
     t *= 1.0 + v.lumps * (2.0 * (0.7 * noise(l.x, l.y, l.z + 60.0) + 0.3 * noise(2.3 * l.x, 2.3 * l.y, 2.3 * l.z)) - 1.0);
+    // Clumps: crests stand up and partings sink between them, so the
+    // silhouette is broken by tufts and not a helmet's smooth shell.
+    t *= 1.0 + v.tufts * (2.0 * hair_tuft(base) - 1.0);
     return t * glm::smoothstep(0.0, v.fade, above);
 }
 
@@ -445,6 +521,9 @@ glm::dvec3 FaceShape::displace(glm::dvec3 base) const {
     if (side > 0.0) {
         const double e = ear_relief(base.y, base.z) * side;
         if (e > 0.0) p = p + n * e;
+        const glm::dvec2 pull = ear_rim_pull(base.y, base.z) * side;
+        p.y += pull.x;
+        p.z += pull.y;
     }
     const double hair = hair_thickness(base, n);
     if (hair > 0.0) p = p + n * hair;

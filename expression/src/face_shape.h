@@ -114,12 +114,31 @@ public:
     // long axis, -1 lobe .. 1 top) and s (across it, -1 the free back rim ..
     // 1 the front edge where the ear joins the head).
     glm::dvec2 ear_point(double a, double s) const;
+    // The in-plane move (y, z) that draws a side point near the ear's
+    // outline onto it, so the rim's edge follows the outline, not the grid.
+    glm::dvec2 ear_rim_pull(double y, double z) const;
 
     // The hairline's height (y) at a point of the head, from face.json
     // "hair" (the front line over the forehead and temples, the sideburn,
     // over the ear, down to the nape), with the temples' recession and a
     // line that wanders by a millimetre or two, differently on each side.
     double hairline(glm::dvec3 q) const;
+    // How far above the hairline a point of the head lies, in mm along the
+    // head (negative below it): the height over hairline() divided by the
+    // line's steepness, so the band is as wide where the line runs down the
+    // temple as where it crosses the forehead.
+    double hair_height(glm::dvec3 q) const;
+    // Where a point lies in the hair's flow from the crown's whorl: across
+    // it (mm round the crown at a typical distance; the whorl's spiral
+    // turns it with distance) and along it (mm from the crown).
+    struct HairFlow {
+        double azimuth, across, along;
+    };
+    HairFlow hair_flow(glm::dvec3 q) const;
+    // The clump the hair gathers in at q: 1 on a tuft's crest, 0 in the
+    // parting beside it (face.json head.hair_volume tuft_mm), the same for
+    // the volume and the paint.
+    double hair_tuft(glm::dvec3 q) const;
     // How far the hair stands off the scalp at a head-volume point with
     // outward normal n (0 below the hairline).
     double hair_thickness(glm::dvec3 base, glm::dvec3 n) const;

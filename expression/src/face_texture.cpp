@@ -245,38 +245,27 @@ double Painter::hair(glm::dvec3 q, Rgb* colour, double* roots) const {
     *roots = 0.0;
     const double ax = std::abs(q.x);
     // The hairline is the head's (FaceShape: the hair volume rises from the
-    // same line), so paint and geometry agree.
+    // same line, measured the same way along the head), so paint and
+    // geometry agree.
     const double line = s_.hairline(q);
-    // Height above the hairline (whose course wanders: FaceShape; a
-    // saw-tooth edge reads as a wig, the fine hairs below make it irregular
-    // at the small scale).
-    double edge = q.y - line;
-    // Leave the ears bare.
-    if (ax > 55 && s_.ear_relief(q.y, q.z) > 0.3) edge = std::min(edge, -4.0);
+    // A cheap bound first: hair_height is the height over the line divided
+    // by the line's steepness (at least 1), so nothing far below it paints.
     const double band = p_.hairline_band;
     const FaceParams::Albedo::FineHairs& fh = p_.albedo.fine_hairs;
+    if (q.y - line < -0.4 * band - fh.length[1] - 30.0) return 0.0;
+    // Height above the hairline along the head (whose course wanders:
+    // FaceShape; a saw-tooth edge reads as a wig, the fine hairs below make
+    // it irregular at the small scale).
+    double edge = s_.hair_height(q);
+    // Leave the ears bare.
+    if (ax > 55 && s_.ear_relief(q.y, q.z) > 0.3) edge = std::min(edge, -4.0);
     if (edge < -0.4 * band - fh.length[1]) return 0.0;
     // Where hair grows the roots show grey through the skin; they thin out
     // with the hair below the line.
     *roots = glm::smoothstep(-0.5 * band, 0.6 * band, edge);
 
-    // Strand coordinates round the crown. The azimuth's wrap (+-pi) lies
-    // behind and below the crown, on the nape, where no view of the face
-    // sees the seam it makes in the strands.
-    const glm::dvec3 rel = q - p_.hair_crown;
-    const double along = glm::length(rel);
-    const glm::dvec3 axis = glm::normalize(p_.hair_crown);
-    const glm::dvec3 e1 = -glm::normalize(glm::cross(axis, glm::dvec3{1.0, 0.0, 0.0}));
-    const glm::dvec3 e2 = glm::cross(axis, e1);
-    // The whorl's spiral: strands turn round the crown with distance, most
-    // over the front (the hair sweeps across the forehead instead of
-    // falling straight onto it as a fringe) and not at all at the nape,
-    // so the azimuth's wrap stays there.
-    const double straight = std::atan2(glm::dot(rel, e2), glm::dot(rel, e1));
-    const double facing = std::cos(0.5 * straight);
-    const double azimuth = straight + p_.hair_swirl * (along / 100.0) * facing * facing;
-    // Across in mm at a typical distance; fanning out with distance is the whorl.
-    const double across = azimuth * 70.0;
+    const FaceShape::HairFlow flow = s_.hair_flow(q);
+    const double azimuth = flow.azimuth, across = flow.across, along = flow.along;
     const double w = p_.hair_strand_width, len = p_.hair_strand_length;
     // Clumps: bands across whose course sways as they run (combed hair is
     // not a set of parallel grooves), each with its own width, tone and
@@ -310,6 +299,10 @@ double Painter::hair(glm::dvec3 q, Rgb* colour, double* roots) const {
     value *= 0.8 + 0.4 * hash(ci, 11, 5);
     value *= 0.75 + 0.5 * noise(cu * 0.4, along / 14.0, 15.0);  // tufts of a few clumps
     value *= 0.72 + 0.56 * noise(q.x * 0.08, q.y * 0.08, q.z * 0.08 + 9.0);
+    // The volume's tufts (FaceShape::hair_tuft): their crests catch the
+    // light and the partings between them are dark with roots and shadow.
+    const double tuft = s_.hair_tuft(q);
+    value *= 1.0 - p_.hair_tuft_shade * (1.0 - tuft) * (1.0 - tuft) + 0.25 * p_.hair_tuft_shade * tuft;
     const Rgb hair_colour = from255(p_.hair);
     *colour = hair_colour * std::max(value, 0.15);
 
@@ -459,9 +452,17 @@ Texel Painter::skin(glm::dvec3 q) const {
         const double orbit = field(ax, q.y, eye_x - 3.0, eye_y - 6.0, 11.0, 5.5) + 0.5 * field(ax, q.y, eye_x, eye_y + 3.0, 12.0, 6.0);
         c = tint(c, al.periorbital_tint, al.periorbital_amount * std::min(orbit, 1.0));
 
-        // T-zone: forehead centre and nose are oilier (glossier).
-        const double t_zone = std::max(field(q.x, q.y, 0.0, 40.0, 22.0, 18.0), field(q.x, q.y, 0.0, -20.0, 9.0, 24.0));
-        gloss = mix(1.0, p_.gloss.t_zone, std::min(t_zone, 1.0));
+        // T-zone: the forehead and the nose are oilier (glossier), the
+        // cheeks drier. Sebum lies in patches (pooled around follicles,
+        // rubbed off here and there), not as one even film: broken at a few
+        // mm and, as sparse glints anywhere, at about a millimetre, so the
+        // sheen along the forehead's curve is broken up instead of one
+        // streak down its middle; the glabella between the forehead's
+        // field and the nose's is drier.
+        const double t_zone = std::max(field(q.x, q.y, 0.0, 42.0, 24.0, 14.0), field(q.x, q.y, 0.0, -24.0, 8.0, 18.0));
+        const double patches = glm::smoothstep(0.3, 0.75, fbm(q.x * 0.22, q.y * 0.22, q.z * 0.22 + 41.0));
+        const double glints = glm::smoothstep(0.55, 0.85, noise(q.x * 0.9, q.y * 0.9, q.z * 0.9 + 43.0));
+        gloss = mix(1.0, p_.gloss.t_zone, std::min(t_zone, 1.0) * (0.3 + 0.7 * patches) + 0.2 * glints);
 
         // Lips: the vermilion fades into the skin over the border's width
         // (its course wanders a little: a drawn curve reads as lipstick), a
