@@ -47,6 +47,7 @@ AnchoredPoint read_point(JsonReader item) {
         point.from = feature_index(fp);
     }
     if (item.has("offset")) point.offset = read_vec2(item.at("offset"));
+    point.depth_factor = read_number(item, "depth_factor", 1.0f, 0.0f, 1.0f);
     item.finish();
     return point;
 }
@@ -78,6 +79,7 @@ WrinkleSpec read_wrinkle(JsonReader item) {
     if (item.has("step")) w.step = read_vec2(item.at("step"));
     w.depth_falloff = read_number(item, "depth_falloff", 1.0f, 0.0f, 2.0f);
     w.side = read_number(item, "side", 1.0f, -1.0f, 1.0f) < 0.0f ? -1.0f : 1.0f;
+    w.shoulder = item.has("shoulder") ? read_number(item, "shoulder", 0.0f, 0.0f, 1.0f) : -1.0f;
     item.finish();
     return w;
 }
@@ -90,7 +92,8 @@ struct Stroke {
     std::vector<glm::vec2> polyline;
     std::vector<float> arc;  // cumulative arc length at each polyline vertex
     std::vector<float> keep;  // depth factor at each vertex (1; less near the hairline)
-    float depth, sigma, taper, taper_end, crease, side;
+    std::vector<float> along;  // the points' depth_factor at each vertex (depth and width)
+    float depth, sigma, taper, taper_end, crease, side, shoulder;
     float swell_phase;  // where along the swell noise this stroke starts
     bool fine;          // a fine secondary line: a plain valley, no shoulders
     float split = 0.0f;  // +1 / -1: only the face's left / right half of it (an `across` wrinkle on one side)
@@ -145,9 +148,10 @@ glm::vec2 resolve(const AnchoredPoint& p, const FeatureLayout& layout, float uni
     return base + unit * glm::vec2(p.offset.x, -p.offset.y);
 }
 
+constexpr int kSamplesPerSpan = 12;
+
 std::vector<glm::vec2> catmull_rom(const std::vector<glm::vec2>& points) {
     if (points.size() < 3) return points;
-    constexpr int kSamplesPerSpan = 12;
     std::vector<glm::vec2> out;
     const int n = static_cast<int>(points.size());
     for (int i = 0; i + 1 < n; ++i) {
@@ -171,8 +175,9 @@ std::vector<float> arc_lengths(const std::vector<glm::vec2>& line) {
 
 // The part of a curve between arc fractions u0 < u1, resampled at even arc
 // steps, so meander and swell are even along it.
+constexpr int kSamples = 40;
+
 std::vector<glm::vec2> resample(const std::vector<glm::vec2>& line, float u0, float u1) {
-    constexpr int kSamples = 40;
     const std::vector<float> arc = arc_lengths(line);
     const float total = arc.back();
     std::vector<glm::vec2> out;
@@ -202,13 +207,17 @@ std::vector<glm::vec2> displace(const std::vector<glm::vec2>& line, OffsetFn&& o
     return out;
 }
 
-Stroke make_stroke(WrinkleProfile profile, std::vector<glm::vec2> polyline, float depth, float sigma, float taper,
-                   float taper_end, float crease, float side, float swell_phase, bool fine, float reach) {
+Stroke make_stroke(WrinkleProfile profile, std::vector<glm::vec2> polyline, std::vector<float> along, float depth,
+                   float sigma, float taper, float taper_end, float crease, float side, float shoulder,
+                   float swell_phase, bool fine, float reach) {
     Stroke s;
     s.profile = profile;
     s.polyline = std::move(polyline);
     s.arc = arc_lengths(s.polyline);
     s.keep.assign(s.polyline.size(), 1.0f);
+    s.along = std::move(along);
+    s.along.resize(s.polyline.size(), 1.0f);
+    s.shoulder = shoulder;
     s.depth = depth;
     s.sigma = sigma;
     s.taper = taper;
@@ -227,6 +236,38 @@ Stroke make_stroke(WrinkleProfile profile, std::vector<glm::vec2> polyline, floa
     return s;
 }
 
+// The points' depth_factor along a curve through them, by the curve's arc
+// fraction: smooth (smoothstep) between the points, which the Catmull-Rom
+// curve passes at every kSamplesPerSpan-th vertex.
+struct DepthAlong {
+    std::vector<float> at, factor;  // arc fraction of each point, its factor
+    DepthAlong(const WrinkleSpec& spec, const std::vector<glm::vec2>& curve) {
+        const std::vector<float> arc = arc_lengths(curve);
+        const size_t n = spec.points.size();
+        const size_t stride = n < 3 ? 1 : kSamplesPerSpan;
+        for (size_t k = 0; k < n; ++k) {
+            at.push_back(arc.back() > 0.0f ? arc[std::min(k * stride, arc.size() - 1)] / arc.back() : 0.0f);
+            factor.push_back(spec.points[k].depth_factor);
+        }
+    }
+    float operator()(float u) const {
+        if (u <= at.front()) return factor.front();
+        for (size_t k = 0; k + 1 < at.size(); ++k)
+            if (u <= at[k + 1]) {
+                const float span = at[k + 1] - at[k];
+                const float t = span > 0.0f ? smoothstep01((u - at[k]) / span) : 1.0f;
+                return factor[k] + t * (factor[k + 1] - factor[k]);
+            }
+        return factor.back();
+    }
+    // At n + 1 even steps over the arc fractions [u0, u1].
+    std::vector<float> sample(float u0, float u1, int n) const {
+        std::vector<float> out;
+        for (int i = 0; i <= n; ++i) out.push_back((*this)(u0 + (u1 - u0) * static_cast<float>(i) / n));
+        return out;
+    }
+};
+
 // Appends the strokes of `specs` at `layout`, depths times `scale`, each
 // limited to one half of the face by `split` (0: whole).
 void resolve_strokes(const std::vector<WrinkleSpec>& specs, const FoldShape& shape, const FeatureLayout& layout,
@@ -241,6 +282,8 @@ void resolve_strokes(const std::vector<WrinkleSpec>& specs, const FoldShape& sha
         const float sigma = spec.width * unit;
         const float taper_end = spec.taper_end < 0.0f ? spec.taper : spec.taper_end;
         const float crease = spec.crease < 0.0f ? shape.core : spec.crease;
+        const float shoulder = spec.shoulder < 0.0f ? shape.shoulder : spec.shoulder;
+        const DepthAlong depth_along(spec, curve);
         // A valley with its shoulders on the wide flank reaches this far.
         const float wide = 1.0f + shape.asymmetry;
         const float reach = std::max(spec.profile == WrinkleProfile::Fold
@@ -248,8 +291,9 @@ void resolve_strokes(const std::vector<WrinkleSpec>& specs, const FoldShape& sha
                                          : (shape.shoulder_offset + 3.0f * shape.shoulder_width) * wide * sigma,
                                      3.0f * shape.wall_width * wide * sigma);
         if (curve.size() == 1) {  // a round mark: no along-the-fold shape
-            strokes.push_back(make_stroke(spec.profile, curve, scale * spec.depth * unit, sigma, 0.0f, 0.0f, crease,
-                                          spec.side, 0.0f, false, 3.0f * sigma));
+            strokes.push_back(make_stroke(spec.profile, curve, {spec.points[0].depth_factor},
+                                          scale * spec.depth * unit, sigma, 0.0f, 0.0f, crease, spec.side, shoulder,
+                                          0.0f, false, 3.0f * sigma));
             continue;
         }
         const bool varied = spec.count > 1;
@@ -279,13 +323,16 @@ void resolve_strokes(const std::vector<WrinkleSpec>& specs, const FoldShape& sha
                 const float start = (1.0f - shape.fine_length) * random01(seed, copy, 6);
                 std::vector<glm::vec2> fine = resample(line, start, start + shape.fine_length);
                 fine = displace(fine, [&](float) { return side * shape.fine_offset * sigma; });
+                const float f0 = u0 + (u1 - u0) * start, f1 = u0 + (u1 - u0) * (start + shape.fine_length);
                 strokes.push_back(make_stroke(WrinkleProfile::Groove, std::move(fine),
+                                              depth_along.sample(f0, f1, kSamples),
                                               shape.fine_depth * copy_depth * unit, shape.fine_width * sigma, 0.4f,
-                                              0.4f, 0.0f, spec.side, phase + 13.0f, true,
+                                              0.4f, 0.0f, spec.side, 0.0f, phase + 13.0f, true,
                                               3.0f * shape.fine_width * sigma));
             }
-            strokes.push_back(make_stroke(spec.profile, std::move(line), copy_depth * unit, sigma, spec.taper,
-                                          taper_end, crease, spec.side, phase, false, reach));
+            strokes.push_back(make_stroke(spec.profile, std::move(line), depth_along.sample(u0, u1, kSamples),
+                                          copy_depth * unit, sigma, spec.taper, taper_end, crease, spec.side,
+                                          shoulder, phase, false, reach));
         }
     }
     for (std::size_t i = first; i < strokes.size(); ++i) strokes[i].split = split;
@@ -301,7 +348,7 @@ float bump(float d, float sigma) {
 }
 
 float stroke_height(const Stroke& s, const FoldShape& shape, float unit, glm::vec2 x) {
-    float best = 1e30f, signed_best = 0.0f, arc_at = 0.0f, keep = 1.0f;
+    float best = 1e30f, signed_best = 0.0f, arc_at = 0.0f, keep = 1.0f, along = 1.0f;
     if (s.polyline.size() == 1) {
         best = glm::distance(x, s.polyline[0]);
     } else {
@@ -314,6 +361,7 @@ float stroke_height(const Stroke& s, const FoldShape& shape, float unit, glm::ve
                 best = d;
                 arc_at = s.arc[i] + t * (s.arc[i + 1] - s.arc[i]);
                 keep = s.keep[i] + t * (s.keep[i + 1] - s.keep[i]);
+                along = s.along[i] + t * (s.along[i + 1] - s.along[i]);
                 // Image y points down: a positive cross is the face's-left side of travel.
                 const float cross = ab.x * (x.y - a.y) - ab.y * (x.x - a.x);
                 signed_best = cross >= 0.0f ? d : -d;
@@ -322,13 +370,14 @@ float stroke_height(const Stroke& s, const FoldShape& shape, float unit, glm::ve
     }
     if (s.polyline.size() == 1) {
         switch (s.profile) {
-            case WrinkleProfile::Bulge: return s.depth * bump(best, s.sigma);
-            default: return -s.depth * bump(best, s.sigma);
+            case WrinkleProfile::Bulge: return s.along[0] * s.depth * bump(best, s.sigma);
+            default: return -s.along[0] * s.depth * bump(best, s.sigma);
         }
     }
-    // Along the fold: depth fades in smoothly at both ends, the width narrows
-    // with it (no blunt ends), and the depth swells and thins gently.
-    float window = 1.0f;
+    // Along the fold: depth fades in smoothly at both ends and follows the
+    // points' depth factors, the width narrows with it (no blunt ends), and
+    // the depth swells and thins gently.
+    float window = along;
     const float u = arc_at / std::max(s.arc.back(), 1e-12f);
     if (s.taper > 0.0f) window *= smoothstep01(u / s.taper);
     if (s.taper_end > 0.0f) window *= smoothstep01((1.0f - u) / s.taper_end);
@@ -350,14 +399,14 @@ float stroke_height(const Stroke& s, const FoldShape& shape, float unit, glm::ve
             // Compressed skin buckles into a narrow valley with broad rounded
             // crests beside it (FIDELITY.md 6, HARR).
             // The skin bunches higher beside the steep flank than the gentle one.
-            return depth * (-valley + shape.shoulder * (steep ? 1.0f + 0.5f * shape.asymmetry : 1.0f - 0.5f * shape.asymmetry) *
+            return depth * (-valley + s.shoulder * (steep ? 1.0f + 0.5f * shape.asymmetry : 1.0f - 0.5f * shape.asymmetry) *
                                           bump(best - shape.shoulder_offset * flank, shape.shoulder_width * flank));
         case WrinkleProfile::Bulge:
             return depth * bump(best, sigma);
         case WrinkleProfile::Fold:
             // The cheek rounds broadly over the `side` flank; the other keeps a small shoulder.
             return depth * (-valley + 0.55f * bump(s.side * signed_best - 2.5f * sigma, 2.0f * sigma) +
-                            0.5f * shape.shoulder *
+                            0.5f * s.shoulder *
                                 bump(-s.side * signed_best - shape.shoulder_offset * flank,
                                      shape.shoulder_width * flank));
     }

@@ -608,6 +608,60 @@ float floor_depth(const std::vector<float>& height, int col, int r0 = 0, int r1 
     return -deepest;
 }
 
+// A fold's depth follows its points' depth_factor (the nasolabial fold is
+// deepest at the nose wing) and changes smoothly between them; and a
+// wrinkle's own shoulder (the forehead's broad rolls) overrides fold_shape's.
+struct AlongCase {
+    const char* name;
+    float end_factor;  // the last point's depth_factor
+    float shoulder;    // the wrinkle's shoulder (< 0: fold_shape's)
+};
+
+class DepthAlong : public ::testing::TestWithParam<AlongCase> {};
+
+TEST_P(DepthAlong, PointsShapeTheFold) {
+    WrinkleLibrarySpec library = spec();
+    library.fold.swell = 0.0f;  // no seeded swell: the factors alone
+    WrinkleSpec w;
+    w.name = "test line";
+    w.depth = 0.02f;
+    w.width = 0.02f;
+    w.taper = w.taper_end = 0.05f;
+    w.shoulder = GetParam().shoulder;
+    const int from = fap::feature_point_index("3.12"), to = fap::feature_point_index("3.7");
+    w.points = {AnchoredPoint{from, -1, 0.5f, {0.0f, -0.35f}}, AnchoredPoint{from, to, 0.5f, {0.0f, -0.35f}},
+                AnchoredPoint{to, -1, 0.5f, {0.0f, -0.35f}, GetParam().end_factor}};
+    library.action_units = {AuWrinkles{12, {}, {}, {w}}};
+    const FeatureLayout& layout = key_layout("joy");
+    constexpr int kSize = 512;
+    const std::vector<float> height = render_height_field(library, {{12, AuSide::Both, 1.0f}}, layout, kSize);
+    const glm::vec2 a = layout.at("3.12"), b = layout.at("3.7");
+    const auto column = [&](float t) { return static_cast<int>((a.x + t * (b.x - a.x)) * kSize); };
+    const auto depth_at = [&](float t) { return floor_depth(height, column(t)); };
+    const float near_start = depth_at(0.2f), near_end = depth_at(0.85f);
+    ASSERT_GT(near_start, 0.0f);
+    EXPECT_NEAR(near_end / near_start, GetParam().end_factor, 0.2f) << "the depth does not follow the factors";
+    // Smooth: no jump between neighbouring columns over the middle.
+    float biggest_step = 0.0f;
+    for (int c = column(0.2f); c < column(0.85f); ++c)
+        biggest_step = std::max(biggest_step, std::abs(floor_depth(height, c + 1) - floor_depth(height, c)));
+    EXPECT_LT(biggest_step, 0.05f * near_start);
+    // The crest of bunched skin beside the floor at a quarter along.
+    const int col = column(0.25f);
+    int floor_row = 0;
+    for (int r = 0; r < kSize; ++r)
+        if (height[r * kSize + col] < height[floor_row * kSize + col]) floor_row = r;
+    float crest = 0.0f;
+    for (int r = floor_row - 40; r <= floor_row + 40; ++r) crest = std::max(crest, height[r * kSize + col]);
+    const float expected = GetParam().shoulder < 0.0f ? library.fold.shoulder : GetParam().shoulder;
+    EXPECT_NEAR(crest / -height[floor_row * kSize + col], expected, 0.5f * expected);
+}
+
+INSTANTIATE_TEST_SUITE_P(Cases, DepthAlong,
+                         ::testing::Values(AlongCase{"even", 1.0f, -1.0f}, AlongCase{"fading", 0.3f, -1.0f},
+                                           AlongCase{"broad_rolls", 1.0f, 0.7f}),
+                         [](const auto& info) { return std::string(info.param.name); });
+
 // A fold swells and thins gently along its length (issue 11), instead of
 // keeping one depth like a stroke of a pen: over its middle the floor's
 // depth varies clearly, yet smoothly from column to column.
@@ -844,7 +898,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadSpec{"typo_in_wrinkle",
                 R"({"action_units": {"AU6": {"left": [{"name": "a", "dpeth": 0.1, "points": [{"fp": "4.1"}]}]}}})",
                 "action_units.AU6.left[0].dpeth: expected a known key (name, profile, points, depth, width, taper, taper_end, "
-                "crease, count, step, depth_falloff, side, why), found \"dpeth\""},
+                "crease, count, step, depth_falloff, side, shoulder, why), found \"dpeth\""},
         BadSpec{"typo_at_top", R"({"action_units": {}, "neutral_skin_detial": {}})",
                 "neutral_skin_detial: expected a known key (action_units, fold_shape, cavity, neutral_skin_detail, "
                 "about), found \"neutral_skin_detial\""},
@@ -872,7 +926,7 @@ INSTANTIATE_TEST_SUITE_P(
                 "action_units.AU2.left[0].points[0].offset: expected an array of 2 numbers, found [1]"},
         BadSpec{"typo_in_point",
                 R"({"action_units": {"AU2": {"left": [{"name": "d", "points": [{"fp": "4.1", "ofset": [1, 2]}]}]}}})",
-                "action_units.AU2.left[0].points[0].ofset: expected a known key (fp, offset), found \"ofset\""},
+                "action_units.AU2.left[0].points[0].ofset: expected a known key (fp, offset, depth_factor), found \"ofset\""},
         BadSpec{"not_json", "{\n \"action_units\": {\n  \"AU6\": [,]\n }\n}",
                 "action_units.AU6[0]: expected valid JSON, found syntax error while parsing value - unexpected ','; "
                 "expected '[', '{', "

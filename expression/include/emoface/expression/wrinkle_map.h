@@ -38,6 +38,8 @@ struct AnchoredPoint {
     int to = -1;  // -1: no interpolation
     float t = 0.5f;
     glm::vec2 offset{0.0f};
+    float depth_factor = 1.0f;  // the wrinkle's depth (and, with it, width) here, as a fraction of its
+                                // depth; between points it changes smoothly (deepest near the nose wing)
 };
 
 struct WrinkleSpec {
@@ -54,6 +56,8 @@ struct WrinkleSpec {
     glm::vec2 step{0.0f};  // ... each moved by this many face units from the last
     float depth_falloff = 1.0f;  // depth multiplier from one copy to the next
     float side = 1.0f;     // Fold: which side of the curve bulges (+1 left of travel)
+    float shoulder = -1.0f;  // crest height of the bunched skin beside it (< 0: FoldShape::shoulder);
+                             // high where neighbouring folds share broad rolls (the forehead)
 };
 
 // How every groove and fold is shaped, for all wrinkles alike (wrinkles.json
