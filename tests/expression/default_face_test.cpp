@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <string>
+#include <vector>
 
 #include <unistd.h>
 
@@ -295,6 +297,86 @@ TEST(DefaultFace, BaseColourPaintsLipsRedderThanSkinAndHairDarker) {
     // Lips: less green relative to red than skin.
     EXPECT_LT(lip[1] * 1.0 / lip[0], cheek[1] * 1.0 / cheek[0] - 0.05);
     EXPECT_LT(crown[0] + crown[1] + crown[2], (cheek[0] + cheek[1] + cheek[2]) / 2);
+}
+
+// The mouth's colouring (face_texture.cpp): lips darker where they meet
+// than mid-lip, their gloss broken up rather than one even varnish, and
+// the incisors' necks yellower than their translucent edges.
+TEST(DefaultFace, BaseColourShadesLipsUnevenlyAndTeethFromNeckToEdge) {
+    DefaultFaceOptions options;
+    options.resolution_scale = 0.5;
+    options.texture_size = 512;
+    const Face f = make_default_face(testing::data_dir() + "/face", options);
+    auto texel_at = [&](TriMesh::TexCoord2D t) {
+        const int x = std::min(511, static_cast<int>(t[0] * 512));
+        const int y = std::min(511, static_cast<int>((1 - t[1]) * 512));
+        const std::uint8_t* p = &f.base_colour.rgba[(static_cast<std::size_t>(y) * 512 + x) * 4];
+        return std::array<int, 4>{p[0], p[1], p[2], p[3]};
+    };
+    auto uv = [&](const char* id) { return f.mesh.texcoord2D(TriMesh::VertexHandle(f.feature_points[fp(id)].vertex)); };
+    auto luma = [](const std::array<int, 4>& c) { return 0.3 * c[0] + 0.59 * c[1] + 0.11 * c[2]; };
+    // The lower lip from where the lips meet (2.3) to its border (8.2).
+    const auto near_line = texel_at(uv("2.3") * 0.9f + uv("8.2") * 0.1f);
+    const auto mid_lip = texel_at(uv("2.3") * 0.5f + uv("8.2") * 0.5f);
+    EXPECT_GT(luma(mid_lip), 1.14 * luma(near_line)) << luma(mid_lip) << " vs " << luma(near_line);
+    // Gloss (alpha) over the lower lip's middle third: it varies.
+    int lo = 255, hi = 0;
+    for (float s = -0.3f; s <= 0.3f; s += 0.02f) {
+        const auto t = (uv("2.3") * 0.5f + uv("8.2") * 0.5f) * (1.0f - std::abs(s)) + (s < 0 ? uv("8.4") : uv("8.3")) * std::abs(s);
+        lo = std::min(lo, texel_at(t)[3]);
+        hi = std::max(hi, texel_at(t)[3]);
+    }
+    EXPECT_GT(hi - lo, 20) << lo << ".." << hi;
+    // The upper incisor: neck (9.8, at the gum) yellower than its edge (9.10).
+    const auto neck = texel_at(uv("9.8")), edge = texel_at(uv("9.10"));
+    EXPECT_LT(neck[2] * 1.0 / neck[0], edge[2] * 1.0 / edge[0] - 0.15) << neck[2] * 1.0 / neck[0] << " vs " << edge[2] * 1.0 / edge[0];
+}
+
+// The haircut's outline seen from the front is broken by its tufts
+// (face.json head.hair_volume tuft_mm, tufts), not a helmet's smooth dome:
+// over the top of the head, the outline's height wanders about its own
+// running mean (12 mm) far more than the same face's with the tufts off.
+TEST(DefaultFace, HairOutlineIsBrokenByTufts) {
+    auto roughness = [](const std::string& dir) {
+        DefaultFaceOptions options;
+        options.resolution_scale = 0.5;
+        options.texture_size = 16;
+        const Face f = make_default_face(dir, options);
+        // The highest skin point in 1 mm bins of x over the top of the head.
+        constexpr int kHalf = 40, kMean = 6;
+        std::vector<double> top(2 * kHalf + 1, -1e9);
+        for (int v = 0; v < f.vertex_count(); ++v) {
+            if (f.parts[v] != VertexPart::Skin) continue;
+            const auto q = f.mesh.point(TriMesh::VertexHandle(v));
+            const long bin = std::lround(q[0]) + kHalf;
+            if (bin >= 0 && bin <= 2 * kHalf) top[static_cast<std::size_t>(bin)] = std::max(top[static_cast<std::size_t>(bin)], double(q[1]));
+        }
+        double sum = 0.0;
+        int n = 0;
+        for (int k = kMean; k <= 2 * kHalf - kMean; ++k) {
+            double mean = 0.0;
+            for (int d = -kMean; d <= kMean; ++d) mean += top[static_cast<std::size_t>(k + d)] / (2 * kMean + 1);
+            const double r = top[static_cast<std::size_t>(k)] - mean;
+            sum += r * r;
+            ++n;
+        }
+        return std::sqrt(sum / n);
+    };
+    const double tufted = roughness(testing::data_dir() + "/face");
+    // The same face with the tufts off.
+    std::ifstream in(testing::data_dir() + "/face/face.json");
+    std::string text(std::istreambuf_iterator<char>(in), {});
+    const std::string key = "\"tufts\": ";
+    const auto at = text.find(key);
+    ASSERT_NE(at, std::string::npos) << key;
+    const auto end = text.find_first_of(",}", at + key.size());
+    text.replace(at + key.size(), end - at - key.size(), "0");
+    const auto dir = std::filesystem::temp_directory_path() / ("emoface_smooth_hair_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir / "face.json") << text;
+    const double smooth = roughness(dir.string());
+    std::filesystem::remove_all(dir);
+    EXPECT_GT(tufted, 2.0 * smooth) << "mm RMS about the outline's running mean, with tufts and without";
 }
 
 class BadFaceParams : public ::testing::Test {
