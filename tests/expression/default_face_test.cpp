@@ -7,8 +7,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <string>
-#include <vector>
 
 #include <unistd.h>
 
@@ -330,53 +328,6 @@ TEST(DefaultFace, BaseColourShadesLipsUnevenlyAndTeethFromNeckToEdge) {
     // The upper incisor: neck (9.8, at the gum) yellower than its edge (9.10).
     const auto neck = texel_at(uv("9.8")), edge = texel_at(uv("9.10"));
     EXPECT_LT(neck[2] * 1.0 / neck[0], edge[2] * 1.0 / edge[0] - 0.15) << neck[2] * 1.0 / neck[0] << " vs " << edge[2] * 1.0 / edge[0];
-}
-
-// The haircut's outline seen from the front is broken by its tufts
-// (face.json head.hair_volume tuft_mm, tufts), not a helmet's smooth dome:
-// over the top of the head, the outline's height wanders about its own
-// running mean (12 mm) far more than the same face's with the tufts off.
-TEST(DefaultFace, HairOutlineIsBrokenByTufts) {
-    auto roughness = [](const std::string& dir) {
-        DefaultFaceOptions options;
-        options.resolution_scale = 0.5;
-        options.texture_size = 16;
-        const Face f = make_default_face(dir, options);
-        // The highest skin point in 1 mm bins of x over the top of the head.
-        constexpr int kHalf = 40, kMean = 6;
-        std::vector<double> top(2 * kHalf + 1, -1e9);
-        for (int v = 0; v < f.vertex_count(); ++v) {
-            if (f.parts[v] != VertexPart::Skin) continue;
-            const auto q = f.mesh.point(TriMesh::VertexHandle(v));
-            const long bin = std::lround(q[0]) + kHalf;
-            if (bin >= 0 && bin <= 2 * kHalf) top[static_cast<std::size_t>(bin)] = std::max(top[static_cast<std::size_t>(bin)], double(q[1]));
-        }
-        double sum = 0.0;
-        int n = 0;
-        for (int k = kMean; k <= 2 * kHalf - kMean; ++k) {
-            double mean = 0.0;
-            for (int d = -kMean; d <= kMean; ++d) mean += top[static_cast<std::size_t>(k + d)] / (2 * kMean + 1);
-            const double r = top[static_cast<std::size_t>(k)] - mean;
-            sum += r * r;
-            ++n;
-        }
-        return std::sqrt(sum / n);
-    };
-    const double tufted = roughness(testing::data_dir() + "/face");
-    // The same face with the tufts off.
-    std::ifstream in(testing::data_dir() + "/face/face.json");
-    std::string text(std::istreambuf_iterator<char>(in), {});
-    const std::string key = "\"tufts\": ";
-    const auto at = text.find(key);
-    ASSERT_NE(at, std::string::npos) << key;
-    const auto end = text.find_first_of(",}", at + key.size());
-    text.replace(at + key.size(), end - at - key.size(), "0");
-    const auto dir = std::filesystem::temp_directory_path() / ("emoface_smooth_hair_" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir);
-    std::ofstream(dir / "face.json") << text;
-    const double smooth = roughness(dir.string());
-    std::filesystem::remove_all(dir);
-    EXPECT_GT(tufted, 2.0 * smooth) << "mm RMS about the outline's running mean, with tufts and without";
 }
 
 class BadFaceParams : public ::testing::Test {
