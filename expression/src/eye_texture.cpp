@@ -92,11 +92,16 @@ std::array<double, 3> eye_colour(const FaceShape& shape, double polar, double az
     Rgb c = sclera;
     constexpr double kLimbusSoftness = 0.06;  // radians over which the iris fades into the sclera
     if (polar < ai + kLimbusSoftness) {
-        // Iris: bright radial fibres over darker gaps that wave a little as
-        // they run out, a jagged collarette a third of the way out with the
-        // warmer pupillary zone inside it, crypts beside it, faint
-        // contraction furrows round the outer part, the dark pupillary ruff,
-        // and the limbal ring where the iris meets the sclera.
+        // Iris: radial fibres over darker gaps that wave a little as they
+        // run out, a jagged collarette a third of the way out with the
+        // warmer pupillary zone inside it whose colour frays outwards along
+        // the fibres (a hazel eye: amber round the pupil over a grey-green
+        // stroma), crypts beside it, faint contraction furrows round the
+        // outer part, the dark pupillary ruff, and a broad limbal ring where
+        // the iris meets the sclera. The fibres vary the brightness by under
+        // half: at full contrast with a flat grey-blue colour the iris read
+        // as a bright blue glass disc (blind review, session 6), and its
+        // light outer part merged with the sclera, so the iris read small.
         const double t = std::clamp((polar - ap) / (ai - ap), 0.0, 1.0);
         const double bend = azimuth + 0.12 * t + 0.03 * std::sin(9.0 * t + 3.0 * azimuth);
         const double strands = 0.5 + 0.5 * std::sin(83.0 * bend + 2.5 * std::sin(11.0 * bend));
@@ -104,17 +109,24 @@ std::array<double, 3> eye_colour(const FaceShape& shape, double polar, double az
                               0.3 * (0.5 + 0.5 * std::sin(37.0 * bend - 2.0 * t + 1.0));
         const double collarette = 0.36 + 0.05 * std::sin(7.0 * azimuth + 0.5) + 0.03 * std::sin(17.0 * azimuth + 2.0);
         Rgb iris = from255(p.iris);
-        iris = blend(iris, from255(p.iris_inner), 0.45 * (1.0 - glm::smoothstep(collarette - 0.1, collarette + 0.03, t)));
-        iris = scaled(iris, 0.62 + 0.7 * fibres);
+        // The pupillary zone's colour runs out along the brighter fibres
+        // past the collarette, in flames, not as a painted disc.
+        const double reach = collarette + 0.15 * strands * (0.6 + 0.4 * std::sin(5.0 * azimuth + 1.0));
+        iris = blend(iris, from255(p.iris_inner), 0.7 * (1.0 - glm::smoothstep(collarette - 0.12, reach + 0.05, t)));
+        iris = scaled(iris, 0.78 + 0.42 * fibres);
         // The collarette's ridge catches light.
         const double ridge = std::exp(-std::pow((t - collarette) / 0.035, 2.0));
-        iris = blend(iris, tinted(from255(p.iris_inner), {1.2, 1.15, 1.1}), 0.25 * ridge);
+        iris = blend(iris, tinted(from255(p.iris_inner), {1.15, 1.1, 1.05}), 0.2 * ridge);
         const double crypt = glm::smoothstep(0.55, 0.95, std::sin(19.0 * azimuth + 1.3) * std::sin(23.0 * (t - collarette) + 0.4));
         iris = scaled(iris, 1.0 - 0.35 * crypt * glm::smoothstep(collarette, collarette + 0.08, t) *
                                  (1.0 - glm::smoothstep(0.7, 0.8, t)));
         const double furrows = std::pow(0.5 + 0.5 * std::sin(kPi * 2.0 * (t - 0.62) / 0.09 + 0.4 * std::sin(5.0 * azimuth)), 6.0);
         iris = scaled(iris, 1.0 - 0.18 * furrows * glm::smoothstep(0.6, 0.7, t) * (1.0 - glm::smoothstep(0.88, 0.92, t)));
-        iris = scaled(iris, 1.0 - 0.65 * glm::smoothstep(0.8, 1.0, t));  // limbal ring
+        // The limbal ring: the stroma darkens over the outer quarter into a
+        // grey-brown band, darkest at the rim (it frames the iris against
+        // the white; a light rim made the iris read small).
+        const double rim = glm::smoothstep(0.72, 1.0, t);
+        iris = blend(iris, tinted(iris, {0.32, 0.31, 0.30}), rim);
         iris = blend(Rgb{0.10, 0.06, 0.045}, iris, glm::smoothstep(0.02, 0.08, t));  // pupillary ruff
         const Rgb pupil{0.012, 0.011, 0.013};
         iris = blend(pupil, iris, glm::smoothstep(0.0, 0.025, t));
@@ -124,10 +136,14 @@ std::array<double, 3> eye_colour(const FaceShape& shape, double polar, double az
     // The upper lid's shadow on the eyeball where it rests on it, soft
     // (the lid stands off the eye by its thickness, and the lashes and the
     // lid's edge both shade it; the key light is above), and a fainter one
-    // under the lower lid.
+    // under the lower lid. It fades out above the upper lid's rest margin:
+    // the tile is fixed to the eyeball, so a shadow painted there showed as
+    // a grey band on the white that a raised lid (AU5: fear, surprise)
+    // bares, where the lid no longer is.
     const double upper_margin = shape.eye.upper(cx + x) - cy;
     const double lower_margin = shape.eye.lower(cx + x) - cy;
-    const double from_upper = glm::smoothstep(upper_margin - 4.0, upper_margin + 0.5, y);
+    const double from_upper = glm::smoothstep(upper_margin - 3.5, upper_margin + 0.3, y) *
+                              (1.0 - glm::smoothstep(upper_margin + 0.3, upper_margin + 2.0, y));
     const double shade = p.lid_shadow * from_upper * (0.6 + 0.4 * from_upper) +
                          0.35 * p.lid_shadow * glm::smoothstep(lower_margin + 1.5, lower_margin - 0.5, y);
     // The corners are deeper in the socket.
