@@ -361,11 +361,13 @@ double FaceShape::ear_relief(double y, double z) const {
     // The helix: from the front top, round the top and down the back; not
     // along the front below its root, nor on the lobe.
     const double helix = (1.0 - glm::smoothstep(0.25, 0.7, s) * glm::smoothstep(0.45, 0.1, a)) * (1.0 - lobe);
-    h += helix * (0.22 * H * gauss(rim_d - 1.7, 1.4) - 0.2 * H * gauss(rim_d - 4.8, 1.7));
+    // Rim and groove are a few grid steps wide (the skin grid is about
+    // 1.4 mm here): a 1.4 mm rim sampled on it saw-toothed along the ear.
+    h += helix * (0.2 * H * gauss(rim_d - 2.4, 2.2) - 0.18 * H * gauss(rim_d - 6.2, 2.4));
     // Antihelix and its two crura, an inner ridge parallel to the rim.
     const double anti = ear_curve_distance(a, s, {{-0.55, -0.3}, {-0.1, -0.48}, {0.32, -0.42}, {0.68, 0.05}});
     const double crus = ear_curve_distance(a, s, {{0.32, -0.42}, {0.3, 0.35}});
-    h += 0.2 * H * gauss(std::min(anti, 1.1 * crus) * mm, 2.2);
+    h += 0.2 * H * gauss(std::min(anti, 1.1 * crus) * mm, 2.8);
     // Concha: a deep bowl in front of the antihelix, behind the tragus.
     const double cu = (a + 0.08) / 0.36, cv = (s - 0.2) / 0.42;
     const double bowl = std::max(0.0, 1.0 - cu * cu - cv * cv);
@@ -382,6 +384,25 @@ double FaceShape::ear_relief(double y, double z) const {
     // front joins the face.
     const double edge = 1.0 - glm::smoothstep(s > 0.6 ? 0.7 : 0.9, 1.0, rho);
     return std::max(h * edge, 0.0);
+}
+
+glm::dvec2 FaceShape::ear_rim_pull(double y, double z) const {
+    // Grid points near the ear's outline are drawn onto it (the band
+    // rho 1 +- kBand is mapped onto itself by d -> d|d|, flat at the
+    // outline), so the wall where the rim drops to the scalp runs along
+    // the outline's smooth curve instead of stepping from one grid cell to
+    // the next: a saw-tooth rim at any grid spacing.
+    constexpr double kBand = 0.16;
+    const double t = p_.ear_tilt_deg * kPi / 180.0;
+    const double dy = y - p_.ear_centre_yz[0], dz = z - p_.ear_centre_yz[1];
+    const double a = (dy * std::cos(t) - dz * std::sin(t)) / p_.ear_radii_yz[0];
+    if (a < -1.3 || a > 1.3) return {0.0, 0.0};
+    const double s = (dy * std::sin(t) + dz * std::cos(t)) / (p_.ear_radii_yz[1] * ear_width(std::clamp(a, -1.0, 1.0)));
+    const double rho = std::sqrt(a * a + s * s);
+    const double d = (rho - 1.0) / kBand;
+    if (std::abs(d) >= 1.0 || rho <= 0.0) return {0.0, 0.0};
+    const double k = (1.0 + kBand * d * std::abs(d)) / rho;
+    return ear_point(a * k, s * k) - glm::dvec2{y, z};
 }
 
 double FaceShape::hairline(glm::dvec3 q) const {
@@ -500,6 +521,9 @@ glm::dvec3 FaceShape::displace(glm::dvec3 base) const {
     if (side > 0.0) {
         const double e = ear_relief(base.y, base.z) * side;
         if (e > 0.0) p = p + n * e;
+        const glm::dvec2 pull = ear_rim_pull(base.y, base.z) * side;
+        p.y += pull.x;
+        p.z += pull.y;
     }
     const double hair = hair_thickness(base, n);
     if (hair > 0.0) p = p + n * hair;

@@ -114,6 +114,9 @@ public:
     // long axis, -1 lobe .. 1 top) and s (across it, -1 the free back rim ..
     // 1 the front edge where the ear joins the head).
     glm::dvec2 ear_point(double a, double s) const;
+    // The in-plane move (y, z) that draws a side point near the ear's
+    // outline onto it, so the rim's edge follows the outline, not the grid.
+    glm::dvec2 ear_rim_pull(double y, double z) const;
 
     // The hairline's height (y) at a point of the head, from face.json
     // "hair" (the front line over the forehead and temples, the sideburn,
