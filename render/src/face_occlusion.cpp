@@ -145,7 +145,7 @@ std::vector<float> bake_face_occlusion(const expression::TriMesh& mesh, const ex
     // and sadness, where the brow no longer overhangs. A gentle shade stays
     // (the lid's crease and the brow still shade it a little in every pose);
     // the lid's shadow on the eyeball is the eye tile's (eye_texture.h).
-    constexpr float kLidShadeKept = 0.4f;
+    constexpr float kLidShadeKept = 0.25f;
     const char* const brow_ids[2][3] = {{"4.1", "4.3", "4.5"}, {"4.2", "4.4", "4.6"}};
     if (parts_known)
         for (std::size_t side = 0; side < std::min<std::size_t>(face.eyeballs.size(), 2); ++side) {
