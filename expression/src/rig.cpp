@@ -68,6 +68,27 @@ double radius_factor(std::string_view id) {
     return it == table.end() ? 0.25 : it->second;
 }
 
+// The apple of the cheek: the malar fat pad over the zygomaticus, which a
+// smile (AU6 pushing from above, AU12 pulling the mouth corner up towards
+// the cheekbone) bunches up and forward, lateral to the nasolabial fold,
+// which it deepens. Its rise is the cheek point's rise plus kCornerShare of
+// the mouth corner's; it moves by kMassUp of that up, kMassForward forward
+// and kMassOut out (kMassUp < 0: see below), most at its centre, nothing medial to the fold.
+// Observers saw a smile that "moves only the mouth" when the cheek only slid
+// up with the skin (issue 11); a Duchenne cheek comes 3-5 mm forward.
+constexpr double kCornerShare = 1.2;
+// The sheet already carries the mass up with the cheek point; held back by a
+// tenth of its rise, it does not crowd the skin under the lower lid further
+// (which creased it past the smoothness bound).
+constexpr double kMassUp = -0.1, kMassForward = 0.35, kMassOut = 0.06;
+// Its reach from its centre, and the fold's width (inside, outside), in ES0.
+constexpr double kMassRadius = 0.45, kFoldInside = 0.02, kFoldOutside = 0.10;
+// Its centre's share of the cheekbone (5.3) against the nose wing (9.1).
+constexpr double kCentreOnCheekbone = 0.6;
+
+// C2 bell, 1 at t = 0 and flat there, 0 from t = 1 on.
+double wendland(double t) { return t >= 1.0 ? 0.0 : std::pow(1.0 - t, 4) * (4.0 * t + 1.0); }
+
 // Feature points no FAP moves that hold the skin around them in place.
 bool is_anchor(std::string_view id) {
     static const char* anchors[] = {"3.7",  "3.8",  "3.11", "3.12", "9.4",  "9.5",  "9.6",  "9.7",  "9.12",
@@ -284,7 +305,6 @@ void FaceRig::build_point_field(const Face& face, double radius_scale) {
     // vertex's weights on the displacements are its shares times S^-1,
     // computed once here.
     constexpr double kBackground = 0.5;
-    auto wendland = [](double t) { return t >= 1.0 ? 0.0 : std::pow(1.0 - t, 4) * (4.0 * t + 1.0); };
     detail::GeodesicGraph graph(face.mesh, face.welded);
     std::vector<std::vector<std::pair<int, double>>> reach(n);  // (entry, share)
     for (std::size_t j = 0; j < entries.size(); ++j)
@@ -367,6 +387,12 @@ void FaceRig::build_point_field(const Face& face, double radius_scale) {
     // lid fold. So the brows' weights on the upper lid are shielded, fully
     // at the margin and fading out over the lid's height (the lid fold, 8-12
     // mm up); the inner lid's own share of the brow is the rule below.
+    auto add_entry = [&](int fp, Driven kind) {
+        lid_fps_.push_back(fp);
+        lid_kind_.push_back(kind);
+        cheek_mass_.push_back({-1, 0.0});
+        return static_cast<int>(lid_fps_.size()) - 1;
+    };
     constexpr double kBrowShield = 0.9;
     std::vector<double> brow_shield(n, 0.0);
     for (int k = 0; k < fap::kFeaturePointCount; ++k) {
@@ -387,9 +413,7 @@ void FaceRig::build_point_field(const Face& face, double radius_scale) {
         // the lower lid's skin moves as one sheet down to the cheek (AU6 and
         // AU7 lift the infraorbital skin with the margin, where it bunches).
         const double fade = (upper ? 0.14 : 0.17) * es0 * radius_scale;
-        const int lid = static_cast<int>(lid_fps_.size());
-        lid_fps_.push_back(k);
-        lid_bulge_.push_back(0);
+        const int lid = add_entry(k, Driven::Follow);
         for (auto [v, g] : graph.within({src}, 0.35 * es0 * radius_scale)) {
             if (parts_[v] != VertexPart::Skin) continue;
             const double x = neutral_[v][0], y = neutral_[v][1];
@@ -410,9 +434,7 @@ void FaceRig::build_point_field(const Face& face, double radius_scale) {
             // margin's rise, most a third of the lid's height below the
             // margin and nothing at the margin or past the lid's skin.
             constexpr double kBulge = 0.45;
-            const int bulge = static_cast<int>(lid_fps_.size());
-            lid_fps_.push_back(k);
-            lid_bulge_.push_back(1);
+            const int bulge = add_entry(k, Driven::LidBulge);
             for (auto [v, g] : graph.within({src}, 0.35 * es0 * radius_scale)) {
                 if (parts_[v] != VertexPart::Skin) continue;
                 const double x = neutral_[v][0], y = neutral_[v][1];
@@ -433,9 +455,7 @@ void FaceRig::build_point_field(const Face& face, double radius_scale) {
         if (!fps_[brow].present) continue;
         constexpr double kBrowFollow = 0.2;
         const double x_inner = margin.front()[0], x_outer = margin.back()[0];
-        const int follow = static_cast<int>(lid_fps_.size());
-        lid_fps_.push_back(brow);
-        lid_bulge_.push_back(0);
+        const int follow = add_entry(brow, Driven::Follow);
         for (auto [v, g] : graph.within({src}, 0.35 * es0 * radius_scale)) {
             if (parts_[v] != VertexPart::Skin) continue;
             const double x = neutral_[v][0], y = neutral_[v][1];
@@ -446,11 +466,80 @@ void FaceRig::build_point_field(const Face& face, double radius_scale) {
             if (w > 1e-5) lid_weights_.push_back({v, follow, static_cast<float>(w)});
         }
     }
+    build_cheek_masses(graph, es0 * radius_scale);
     for (int v = 0; v < n; ++v) {
         if (brow_shield[v] <= 0.0) continue;
         for (int k = influence_start_[v]; k < influence_start_[v + 1]; ++k)
             if (fap::feature_points()[system_fps_[weights_[k].system]].group == 4)
                 weights_[k].weight *= static_cast<float>(1.0 - brow_shield[v]);
+    }
+}
+
+void FaceRig::build_cheek_masses(detail::GeodesicGraph& graph, double es) {
+    auto located = [&](const char* id) {
+        const FeaturePointLocation& p = fps_[fap::feature_point_index(id)];
+        return p.present && p.vertex >= 0;
+    };
+    auto at = [&](const char* id) { return to_v(fps_[fap::feature_point_index(id)].position); };
+    for (const auto& [cheek_id, corner_id, wing_id] : {std::array{"5.3", "8.3", "9.1"}, std::array{"5.4", "8.4", "9.2"}}) {
+        if (!located(cheek_id) || !located(corner_id) || !located(wing_id)) continue;
+        const V cheek = at(cheek_id), corner = at(corner_id), wing = at(wing_id);
+        const double out = cheek[0] > wing[0] ? 1.0 : -1.0;
+        // Its centre: below the eye, between the cheekbone and the nose wing;
+        // its source, the skin vertex nearest to that.
+        const V centre = kCentreOnCheekbone * cheek + (1 - kCentreOnCheekbone) * wing;
+        int source = -1;
+        double nearest = 1e30;
+        for (int v = 0; v < static_cast<int>(neutral_.size()); ++v) {
+            if (parts_[v] != VertexPart::Skin) continue;
+            const double d = glm::length(to_v(neutral_[v]) - centre);
+            if (d < nearest) nearest = d, source = v;
+        }
+        if (source < 0) continue;
+        // The nasolabial fold, seen from the front: from just beside the
+        // top of the nose wing down and out to beyond the mouth corner,
+        // bowed out towards the cheek (a quadratic curve in x, y).
+        const glm::dvec2 a(wing[0] + out * 0.04 * es, wing[1] + 0.04 * es);
+        const glm::dvec2 b(corner[0] + out * 0.12 * es, corner[1] - 0.08 * es);
+        const glm::dvec2 along = glm::normalize(b - a);
+        const glm::dvec2 lateral = glm::dvec2(-along.y, along.x) * (glm::dot(glm::dvec2(-along.y, along.x), glm::dvec2(out, 0.0)) > 0 ? 1.0 : -1.0);
+        const glm::dvec2 bow = 0.5 * (a + b) + 0.05 * es * lateral;
+        constexpr int kSegments = 16;
+        std::array<glm::dvec2, kSegments + 1> fold;
+        for (int i = 0; i <= kSegments; ++i) {
+            const double t = double(i) / kSegments;
+            fold[i] = (1 - t) * (1 - t) * a + 2 * t * (1 - t) * bow + t * t * b;
+        }
+        // Signed distance from the fold (+ towards the cheek).
+        auto beside_fold = [&](const glm::dvec2& p) {
+            double best = 1e30, sign = 1.0;
+            for (int i = 0; i < kSegments; ++i) {
+                const glm::dvec2 e = fold[i + 1] - fold[i];
+                const double t = std::clamp(glm::dot(p - fold[i], e) / glm::dot(e, e), 0.0, 1.0);
+                const glm::dvec2 q = fold[i] + t * e;
+                const double d = glm::length(p - q);
+                if (d < best) {
+                    best = d;
+                    sign = glm::dot(p - fold[i], glm::dvec2(-e.y, e.x) * glm::dot(glm::dvec2(-e.y, e.x), lateral)) >= 0 ? 1.0 : -1.0;
+                }
+            }
+            return sign * best;
+        };
+        const int entry = static_cast<int>(lid_fps_.size());
+        lid_fps_.push_back(fap::feature_point_index(cheek_id));
+        lid_kind_.push_back(Driven::CheekMass);
+        cheek_mass_.push_back({fap::feature_point_index(corner_id), out});
+        const double radius = kMassRadius * es;
+        // Straight-line distance: the graph's edge-path distance zigzags at
+        // the mass's scale and creased its top.
+        const V middle = to_v(neutral_[source]);
+        for (auto [v, path] : graph.within({source}, radius)) {
+            if (parts_[v] != VertexPart::Skin) continue;
+            const double g = glm::length(to_v(neutral_[v]) - middle);
+            const double s = beside_fold({neutral_[v][0], neutral_[v][1]});
+            const double w = wendland(g / radius) * glm::smoothstep(-kFoldInside * es, kFoldOutside * es, s);
+            if (w > 1e-5) lid_weights_.push_back({v, entry, static_cast<float>(w)});
+        }
     }
 }
 
@@ -578,7 +667,7 @@ void FaceRig::build_eyes(const Face& face) {
     // (Only the lid FAPs turn skin about the eye; the inner brow's share
     // of the upper lid moves it as the brow moves the skin above.)
     for (const LidWeight& lw : lid_weights_)
-        if (fap::feature_points()[lid_fps_[lw.lid]].id[0] == '3' && !lid_bulge_[lw.lid])
+        if (fap::feature_points()[lid_fps_[lw.lid]].id[0] == '3' && lid_kind_[lw.lid] == Driven::Follow)
             follow[lw.vertex] = std::max(follow[lw.vertex], lw.weight);
     for (int v = 0; v < static_cast<int>(neutral_.size()); ++v) {
         if (parts_[v] != VertexPart::Skin) continue;
@@ -706,9 +795,19 @@ RigView FaceRig::view() const {
     return r;
 }
 
-std::array<double, 3> FaceRig::lid_displacement(std::size_t i, const std::array<double, 3>& fp) const {
-    if (!lid_bulge_[i]) return fp;
-    return {0.0, 0.0, std::max(fp[1], 0.0)};  // a lower margin's rise, forward
+std::array<double, 3> FaceRig::lid_displacement(std::size_t i,
+                                                const std::array<std::array<double, 3>, fap::kFeaturePointCount>& fp_d) const {
+    const std::array<double, 3>& fp = fp_d[lid_fps_[i]];
+    switch (lid_kind_[i]) {
+    case Driven::Follow: return fp;
+    case Driven::LidBulge: return {0.0, 0.0, std::max(fp[1], 0.0)};  // a lower margin's rise, forward
+    case Driven::CheekMass: {
+        const CheekMass& m = cheek_mass_[i];
+        const double rise = std::max(fp[1], 0.0) + kCornerShare * std::max(fp_d[m.corner][1], 0.0);
+        return {kMassOut * m.out * rise, kMassUp * rise, kMassForward * rise};
+    }
+    }
+    return fp;
 }
 
 RigFrame FaceRig::frame(const FapValues& given) const {
@@ -730,7 +829,7 @@ RigFrame FaceRig::frame(const FapValues& given) const {
         f.points |= nonzero(fp_d[k]);
     }
     for (std::size_t i = 0; i < lid_fps_.size(); ++i) {
-        const std::array<double, 3> d = lid_displacement(i, fp_d[lid_fps_[i]]);
+        const std::array<double, 3> d = lid_displacement(i, fp_d);
         for (int c = 0; c < 3; ++c) f.lid_d[i][c] = d[c];
         f.lids |= nonzero(d);
     }
@@ -887,10 +986,13 @@ DeformedFace FaceRig::deform_reference(const FapValues& given) const {
         }
     }
     bool lids_move = false;
-    for (int k : lid_fps_) lids_move |= fp_d[k][0] != 0 || fp_d[k][1] != 0 || fp_d[k][2] != 0;
+    for (std::size_t i = 0; i < lid_fps_.size(); ++i) {
+        const std::array<double, 3> dk = lid_displacement(i, fp_d);
+        lids_move |= dk[0] != 0 || dk[1] != 0 || dk[2] != 0;
+    }
     if (lids_move)
         for (const LidWeight& lw : lid_weights_) {
-            const std::array<double, 3> dk = lid_displacement(lw.lid, fp_d[lid_fps_[lw.lid]]);
+            const std::array<double, 3> dk = lid_displacement(lw.lid, fp_d);
             pos[lw.vertex] += TriMesh::Point(static_cast<float>(lw.weight * dk[0]), static_cast<float>(lw.weight * dk[1]),
                                              static_cast<float>(lw.weight * dk[2]));
         }

@@ -125,6 +125,9 @@ TEST_P(EachFap, MovesItsFeaturePointAlongTheTableDirectionAndNothingFar) {
     // 2 % of the point's motion (the last of a smooth fade, no plateau edge).
     Vec3d origin = face.position(k);
     double reach = 2.0 * std::max(test_rig().influence_radius(k), 0.35 * es0) + 0.5;
+    // A mouth corner's rise bunches the apple of the cheek (rig.cpp, kMassRadius).
+    if (f == 12 || f == 13 || f == 59 || f == 60)
+        reach = std::max(reach, distance(origin, face.position(fp(f % 2 == 0 ? "5.3" : "5.4"))) + 0.45 * es0 + 0.5);
     bool skip_far = false;
     if (f == 3 || f == 14 || f == 15) {
         skip_far = true;  // checked below: the head above the mouth stays

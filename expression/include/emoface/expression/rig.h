@@ -42,6 +42,10 @@
 
 namespace emoface::expression {
 
+namespace detail {
+class GeodesicGraph;
+}
+
 // The human range of each low-level FAP (data/expression/fap_ranges.json):
 // the rig clamps a frame's FAPs into it, so values no face can reach move the
 // face as far as it goes instead of tearing the mesh. Default: unbounded.
@@ -144,6 +148,9 @@ private:
     };
 
     void build_point_field(const Face& face, double radius_scale);
+    // The cheeks' masses (CheekMass entries), on the skin graph of the
+    // point field; es = ES0 x radius scale.
+    void build_cheek_masses(detail::GeodesicGraph& graph, double es);
     void build_jaw(const Face& face);
     void build_eyes(const Face& face);
     void build_head(const Face& face);
@@ -171,12 +178,27 @@ private:
 
     // Eyes and eyelids.
     std::vector<EyeState> eyes_;
-    std::vector<int> lid_fps_;              // 3.1-3.4 where the face has eyelid margins
-    // Per lid_fps_ entry: true where it is a lower lid's bulge (the skin
-    // below the margin pushed forward as the margin rises), not its motion.
-    std::vector<char> lid_bulge_;
+    // The fields with their own weights beside the point field: the lids
+    // (3.1-3.4 where the face has eyelid margins), the inner brows' share of
+    // the upper lids, the lower lids' bulges and the cheeks' masses. Each
+    // entry is driven by the feature point lid_fps_[i] as its kind says.
+    enum class Driven : char {
+        Follow,     // moves as the feature point moves
+        LidBulge,   // the skin below a lower margin, forward as the margin rises
+        CheekMass,  // the apple of the cheek, up and forward as the cheek and the mouth corner rise
+    };
+    std::vector<int> lid_fps_;
+    std::vector<Driven> lid_kind_;
+    // Per CheekMass entry: the mouth corner whose rise bunches it, and which
+    // way is out (+1 on the face's left).
+    struct CheekMass {
+        int corner;
+        double out;
+    };
+    std::vector<CheekMass> cheek_mass_;  // indexed like lid_fps_ (unused but for CheekMass entries)
     // Entry i's displacement, from the feature points' displacements.
-    std::array<double, 3> lid_displacement(std::size_t i, const std::array<double, 3>& fp) const;
+    std::array<double, 3> lid_displacement(std::size_t i,
+                                           const std::array<std::array<double, 3>, fap::kFeaturePointCount>& fp_d) const;
     std::vector<LidWeight> lid_weights_;
     std::vector<LidVertex> lid_vertices_;
     // Eyelashes: a strand whose first vertex is welded to a lid margin
