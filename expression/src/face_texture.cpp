@@ -452,9 +452,17 @@ Texel Painter::skin(glm::dvec3 q) const {
         const double orbit = field(ax, q.y, eye_x - 3.0, eye_y - 6.0, 11.0, 5.5) + 0.5 * field(ax, q.y, eye_x, eye_y + 3.0, 12.0, 6.0);
         c = tint(c, al.periorbital_tint, al.periorbital_amount * std::min(orbit, 1.0));
 
-        // T-zone: forehead centre and nose are oilier (glossier).
-        const double t_zone = std::max(field(q.x, q.y, 0.0, 40.0, 22.0, 18.0), field(q.x, q.y, 0.0, -20.0, 9.0, 24.0));
-        gloss = mix(1.0, p_.gloss.t_zone, std::min(t_zone, 1.0));
+        // T-zone: the forehead and the nose are oilier (glossier), the
+        // cheeks drier. Sebum lies in patches (pooled around follicles,
+        // rubbed off here and there), not as one even film: broken at a few
+        // mm and, as sparse glints anywhere, at about a millimetre, so the
+        // sheen along the forehead's curve is broken up instead of one
+        // streak down its middle; the glabella between the forehead's
+        // field and the nose's is drier.
+        const double t_zone = std::max(field(q.x, q.y, 0.0, 42.0, 24.0, 14.0), field(q.x, q.y, 0.0, -24.0, 8.0, 18.0));
+        const double patches = glm::smoothstep(0.3, 0.75, fbm(q.x * 0.22, q.y * 0.22, q.z * 0.22 + 41.0));
+        const double glints = glm::smoothstep(0.55, 0.85, noise(q.x * 0.9, q.y * 0.9, q.z * 0.9 + 43.0));
+        gloss = mix(1.0, p_.gloss.t_zone, std::min(t_zone, 1.0) * (0.3 + 0.7 * patches) + 0.2 * glints);
 
         // Lips: the vermilion fades into the skin over the border's width
         // (its course wanders a little: a drawn curve reads as lipstick), a

@@ -579,9 +579,14 @@ Camera FaceScene::frontal_camera(float aspect, float fovy_degrees) const {
 
 Light FaceScene::portrait_light() const {
     Light l;
-    // From above and to the viewer's left: grazing enough on the forehead
-    // and around the eyes that horizontal and vertical wrinkles both shade.
-    l.position = glm::vec4(glm::normalize(glm::vec3(-0.35f, 0.55f, 0.75f)), 0.0f);
+    // A portrait key: 40 degrees to the viewer's left and 35 degrees above
+    // the eyes (Rembrandt-like), so the far cheek, the eye sockets, the
+    // nose's far side and the underside of the nose, lips and jaw turn
+    // away from it and the face gets its shape; grazing enough on the
+    // forehead and around the eyes that horizontal and vertical wrinkles
+    // both shade. At 25 degrees the face was lit almost frontally and
+    // read flat.
+    l.position = glm::vec4(glm::normalize(glm::vec3(-0.53f, 0.57f, 0.63f)), 0.0f);
     l.ambient = glm::vec3(0.16f);
     l.diffuse = glm::vec3(0.95f, 0.93f, 0.9f);
     l.specular = glm::vec3(0.3f);

@@ -235,7 +235,7 @@ struct Renderer::Impl {
             light_diffuse, light_specular, specular_color, shininess, camera_position, projective,
             box, skin_model, skin_surface, scatter_table, max_curvature, mm_per_unit,
             normal_softening, cavity_direct, pore_map, pore_tiles, pore_strength, detail_map, albedo_bump, f0, roughness,
-            lobe_weight, gloss_exponent, sheen_intensity, occlusion, min_curvature, wrap, hair, wet, key_tint,
+            lobe_weight, gloss_exponent, sheen_intensity, occlusion, key_cone, min_curvature, wrap, hair, wet, key_tint,
             fill_direction, fill_colour, rim_direction, rim_colour, sky, ground,
             exposure, tone_map;
     } loc{};
@@ -335,6 +335,7 @@ Renderer::Renderer(Platform& platform) : impl_(std::make_unique<Impl>(platform))
     l.gloss_exponent = u("u_gloss_exponent");
     l.sheen_intensity = u("u_sheen_intensity");
     l.occlusion = u("u_occlusion");
+    l.key_cone = u("u_key_cone");
     l.min_curvature = u("u_min_curvature");
     l.wrap = u("u_wrap");
     l.hair = u("u_hair");
@@ -619,6 +620,7 @@ void Renderer::draw(const DrawOptions& o, const WrinkleTexture* wrinkle_map) {
         glUniform1f(im.loc.gloss_exponent, k.gloss_exponent);
         glUniform2f(im.loc.sheen_intensity, k.matte_sheen, k.full_sheen_gloss);
         glUniform3f(im.loc.occlusion, k.occlusion_key, k.occlusion_fill, k.occlusion_specular);
+        glUniform2f(im.loc.key_cone, k.occlusion_key_lean, k.occlusion_key_cone_max);
         glUniform1f(im.loc.min_curvature, k.min_curvature / k.max_curvature);
         glUniform1f(im.loc.wrap, k.softness);
         glUniform3f(im.loc.hair, k.hair_wrap, k.hair_roughness, k.hair_sheen);

@@ -109,6 +109,7 @@ uniform float u_lobe_weight;
 uniform float u_gloss_exponent;     // roughness x gloss^this (gloss: the base map's alpha)
 uniform vec2 u_sheen_intensity;     // direct sheen at gloss 1 (matte), gloss at which it is full
 uniform vec3 u_occlusion;           // how far the baked occlusion dims: key, fill/rim/sky diffuse, specular
+uniform vec2 u_key_cone;            // the key's contact shadow: the open cone's lean, its narrowest cos
 uniform float u_min_curvature;      // table coordinate: the flattest skin still scatters
 uniform float u_wrap;               // the rig lights' softness (wrapped N.L, energy kept)
 uniform vec3 u_hair;                // hair: wrap, roughness, the lights' sheen
@@ -191,7 +192,7 @@ struct Surface {
     float lobe_weight;
     float cavity;    // 1 open skin, 0 a deep crevice
     float direct_sheen;   // the region's scale of the lights' sheen
-    float key_shadow;     // the occlusion's dimming of the key's diffuse light
+    float key_cone;       // the key's contact shadow: cos of the open cone's half-angle
     float dim_shadow;     // ... of the fill's, the rim's and the sky's
     float dim_sheen;      // specular occlusion of the fill, the rim and the sky
 };
@@ -208,6 +209,21 @@ struct Surface {
 // past 90 degrees and softens; nothing is added).
 vec3 shade_light(Surface s, vec3 l, vec3 c, const bool full) {
     vec3 diffuse;
+    // The key's contact shadow, from the baked occlusion ao: a point open to
+    // a cone of half-angle t has ao = sin^2 t (cosine weighted), so it sees
+    // the key only where the cone's axis . L > cos t. On a face most
+    // occluders lie above (brows over the eyes, the nose over the lip, the
+    // jaw over the neck), so the axis leans down from the normal by
+    // u_key_cone.x (1 - ao) (unnormalised: the lean's dot with L). The
+    // occlusion is baked on the rest shape, stale where the face moves (a
+    // raised lid bares skin that was inside its fold): the cone is never
+    // narrower than u_key_cone.y, so skin facing the key is lit. Soft over
+    // 0.3 (the key is a soft box); u_occlusion.x of it applies.
+    float visible = 1.0;
+    if (full && u_skin_surface) {
+        float toward = dot(s.n_g, l) - u_key_cone.x * s.key_cone * s.key_cone * l.y;
+        visible = mix(1.0, smoothstep(s.key_cone - 0.3, s.key_cone, toward), u_occlusion.x);
+    }
     if (u_skin_surface) {
         float wrap_scale = 1.0 / (1.0 + u_wrap);
         if (full) {
@@ -216,7 +232,7 @@ vec3 shade_light(Surface s, vec3 l, vec3 c, const bool full) {
             diffuse = vec3(textureLod(u_scatter_table, vec2(u.r, s.curvature), 0.0).r,
                            textureLod(u_scatter_table, vec2(u.g, s.curvature), 0.0).g,
                            textureLod(u_scatter_table, vec2(u.b, s.curvature), 0.0).b);
-            diffuse *= wrap_scale * s.key_shadow;
+            diffuse *= wrap_scale * visible;
         } else {
             float u = clamp(0.5 + 0.5 * (dot(s.n_g, l) + u_wrap) * wrap_scale, 0.0, 1.0);
             diffuse = textureLod(u_scatter_table, vec2(u, s.curvature), 0.0).rgb * (wrap_scale * s.dim_shadow);
@@ -224,7 +240,7 @@ vec3 shade_light(Surface s, vec3 l, vec3 c, const bool full) {
         // Hair scatters no light under its surface: wrapped Lambert.
         float hair_wrap_scale = 1.0 / (1.0 + u_hair.x);
         float lambert = max(dot(s.n, l) + u_hair.x, 0.0) * hair_wrap_scale * hair_wrap_scale *
-                        (full ? s.key_shadow : s.dim_shadow);
+                        (full ? visible : s.dim_shadow);
         diffuse = mix(diffuse, vec3(lambert), s.hair) * s.direct_cavity;
     } else {
         diffuse = vec3(max(dot(s.n, l), 0.0));
@@ -239,7 +255,7 @@ vec3 shade_light(Surface s, vec3 l, vec3 c, const bool full) {
                                  (1.0 - s.lobe_weight) * ggx_dv(s.alpha.y, n_dot_h, n_dot_l, s.n_dot_v)
                            : ggx_dv(s.alpha_mean, n_dot_h, n_dot_l, s.n_dot_v);
         float sheen = PI * lobes * fresnel(s.f0, dot(l, h)) * n_dot_l * s.direct_sheen;
-        color += vec3(full ? sheen : sheen * s.dim_sheen);
+        color += vec3(sheen * (full ? visible : s.dim_sheen));
     }
     return color * c;
 }
@@ -337,10 +353,11 @@ vec3 shade_skin(vec3 n_bumped, vec3 n_geo, vec3 base, float cavity, float gloss,
     // The baked occlusion (eye sockets, nostrils, mouth corners, under the
     // jaw, the ears, the hairline) stands for the shadows the rig's broad
     // lights would cast there: fully for the sky, mostly for the fill and
-    // the rim, a little for the key (its shadows are not drawn). With the
+    // the rim, and for the key where it grazes (shade_light; its shadows
+    // are not drawn). With the
     // wrinkle and pore cavity it also fades the sheen (Lagarde & de
     // Rousiers 2014).
-    s.key_shadow = mix(1.0, occlusion, u_occlusion.x);
+    s.key_cone = min(sqrt(max(1.0 - occlusion, 0.0)), u_key_cone.y);
     s.dim_shadow = mix(1.0, occlusion, u_occlusion.y);
     float ambient_open = s.cavity * mix(1.0, occlusion, u_occlusion.z);
     s.dim_sheen = specular_occlusion(s.n_dot_v, ambient_open, mean_roughness);

@@ -72,6 +72,8 @@ SkinShading load_skin_shading(const std::string& path) {
         s.occlusion_key = float(occlusion.number_in("key", 0.0, 1.0));
         s.occlusion_fill = float(occlusion.number_in("fill", 0.0, 1.0));
         s.occlusion_specular = float(occlusion.number_in("specular", 0.0, 1.0));
+        s.occlusion_key_lean = float(occlusion.number_in("key_lean", 0.0, 4.0));
+        s.occlusion_key_cone_max = float(occlusion.number_in("key_cone_max", 0.0, 1.0));
         occlusion.finish();
 
         JsonReader pores = root.object("pores");

@@ -112,13 +112,15 @@ struct SkinShading {
     // matte_sheen at g = 1 up to 1 at g <= full_sheen_gloss (the T-zone,
     // lips, lid margins).
     float gloss_exponent = 2.0f;
-    float matte_sheen = 0.55f;
+    float matte_sheen = 0.4f;
     float full_sheen_gloss = 0.8f;
 
     // --- baked ambient occlusion (ambient_occlusion.h): how far it dims ---
-    float occlusion_key = 0.25f;       // the key's diffuse light (its shadows are not drawn)
+    float occlusion_key = 0.4f;        // the key's light where it grazes (its shadows are not drawn)
     float occlusion_fill = 0.8f;       // the fill's, the rim's and the sky's diffuse light
     float occlusion_specular = 1.0f;   // the sky's, the fill's and the rim's sheen
+    float occlusion_key_lean = 0.5f;   // how far an occluded point's open cone leans down (occluders above)
+    float occlusion_key_cone_max = 0.5f;  // the narrowest open cone's cos (the rest shape's occlusion is stale where the face moves)
 
     // --- pores ---
     PoreMapSpec pores{};
@@ -134,8 +136,8 @@ struct SkinShading {
     // sheen is broad and dim, not skin's.
     std::array<float, 2> hair_luminance{0.06f, 0.13f};  // linear mean luminance: all hair .. all skin
     float hair_wrap = 0.05f;       // N.L wrap of the rig lights on hair (skin: softness)
-    float hair_roughness = 0.6f;   // one GGX roughness for both lobes
-    float hair_sheen = 0.5f;       // the lights' sheen on hair, of skin's full sheen
+    float hair_roughness = 0.75f;  // one GGX roughness for both lobes
+    float hair_sheen = 0.3f;       // the lights' sheen on hair, of skin's full sheen
 
     // --- wet parts (the eyes, the mouth's inside): a tight lobe of the
     // material's shininess plus a weak broad one (a moist film) ---
@@ -146,12 +148,12 @@ struct SkinShading {
 
     // --- light rig (the key light is the draw's Light, tinted) ---
     glm::vec3 key_tint{1.06f, 0.98f, 0.88f};
-    float softness = 0.2f;  // wrap of every rig light's N.L (soft boxes), energy kept
-    RigLight fill{{0.7f, 0.1f, 0.7f}, {0.17f, 0.2f, 0.26f}};
+    float softness = 0.1f;  // wrap of every rig light's N.L (soft boxes), energy kept
+    RigLight fill{{0.7f, 0.1f, 0.7f}, {0.09f, 0.105f, 0.14f}};
     RigLight rim{{0.5f, 0.6f, -0.65f}, {0.36f, 0.34f, 0.31f}};
-    glm::vec3 sky{0.25f, 0.27f, 0.31f};       // ambient from above (+y)
-    glm::vec3 ground{0.14f, 0.105f, 0.085f};  // ambient from below (warm bounce)
-    float exposure = 1.0f;
+    glm::vec3 sky{0.14f, 0.155f, 0.18f};      // ambient from above (+y)
+    glm::vec3 ground{0.08f, 0.06f, 0.05f};  // ambient from below (warm bounce)
+    float exposure = 0.85f;
     ToneMapping tone_mapping = ToneMapping::Aces;
 
     bool operator==(const SkinShading& o) const {
@@ -162,7 +164,8 @@ struct SkinShading {
                lobe_weight == o.lobe_weight && gloss_exponent == o.gloss_exponent &&
                matte_sheen == o.matte_sheen && full_sheen_gloss == o.full_sheen_gloss &&
                occlusion_key == o.occlusion_key && occlusion_fill == o.occlusion_fill &&
-               occlusion_specular == o.occlusion_specular && key_tint == o.key_tint &&
+               occlusion_specular == o.occlusion_specular &&
+               occlusion_key_lean == o.occlusion_key_lean && occlusion_key_cone_max == o.occlusion_key_cone_max && key_tint == o.key_tint &&
                softness == o.softness && pores == o.pores && pore_tiles == o.pore_tiles &&
                pore_strength == o.pore_strength && albedo_bump_mm == o.albedo_bump_mm &&
                albedo_bump_bias == o.albedo_bump_bias && hair_luminance == o.hair_luminance &&
