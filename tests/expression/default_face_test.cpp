@@ -426,12 +426,12 @@ TEST_F(BadFaceParams, MessagesNameTheFileAndKey) {
          "expression: " + file + ": mouth.centre_y: expected a number, found \"low\""},
         {replaced("\"texture_size\": 2048", "\"texture_size\": 9"),
          "expression: " + file + ": resolution.texture_size: expected an integer in [16, 8192], found 9"},
-        {replaced("\"2.10\": [0, -95],", "\"2.10\": [0, -95], \"2.99\": [0, 0],"),
+        {replaced("\"2.10\": [0, -91],", "\"2.10\": [0, -91], \"2.99\": [0, 0],"),
          "expression: " + file + ": feature_points.\"2.99\": expected an MPEG-4 feature point id as the key, found \"2.99\""},
-        {replaced("\"2.10\": [0, -95],", "\"2.10\": [0, -95], \"3.1\": [0, 0],"),
+        {replaced("\"2.10\": [0, -91],", "\"2.10\": [0, -91], \"3.1\": [0, 0],"),
          "expression: " + file + ": feature_points.\"3.1\": expected a point the generator does not place, found one it "
                                 "places (remove it)"},
-        {replaced("\"2.10\": [0, -95],", ""), "expression: " + file + ": feature_points: expected a target for \"2.10\", found none"},
+        {replaced("\"2.10\": [0, -91],", ""), "expression: " + file + ": feature_points: expected a target for \"2.10\", found none"},
     };
     for (const Case& c : cases) {
         const std::string dir = write(c.text);

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "emoface/expression/default_face.h"
@@ -232,10 +233,20 @@ TEST(FaceTexture, CheekRednessIsDiffuseNotADisc) {
 // glossier than the cheek, the hair and cheek are 1.
 TEST(FaceTexture, AlphaHoldsTheRegionsRoughness) {
     const Face& f = painted_face();
-    const auto lip_uv = (f.mesh.texcoord2D(TriMesh::VertexHandle(f.feature_points[fap::feature_point_index("2.3")].vertex)) +
-                         f.mesh.texcoord2D(TriMesh::VertexHandle(f.feature_points[fap::feature_point_index("8.2")].vertex))) *
-                        0.5f;
-    const double lips = texel_at(lip_uv[0], lip_uv[1]).a;
+    // The lips' sheen is broken up (wet where they meet, drier in patches
+    // towards the border): their mean over both lips' middles, not one texel.
+    auto uv_of = [&](const char* id) {
+        return f.mesh.texcoord2D(TriMesh::VertexHandle(f.feature_points[fap::feature_point_index(id)].vertex));
+    };
+    double lips = 0.0;
+    int samples = 0;
+    for (const auto& [inner, outer] : {std::pair{"2.2", "8.1"}, std::pair{"2.3", "8.2"}})
+        for (const float t : {0.2f, 0.35f, 0.5f, 0.65f, 0.8f}) {
+            const auto uv = uv_of(inner) * (1.0f - t) + uv_of(outer) * t;
+            lips += texel_at(uv[0], uv[1]).a;
+            ++samples;
+        }
+    lips /= samples;
     const double cheek = texel_of(front_vertex(45, -35)).a;
     const double nose = texel_of(front_vertex(0, -25)).a;
     const double crown = texel_of(f.feature_points[fap::feature_point_index("11.4")].vertex).a;
