@@ -324,6 +324,7 @@ FaceParams read_face_params(const std::string& params_dir) {
             }
             a.flush_breakup = r.number_in("flush_breakup", 0.0, 1.0);
             a.ear_flush = r.number_in("ear_flush", 0.0, 1.5);
+            a.ear_fold_shade = r.number_in("ear_fold_shade", 0.0, 0.8);
             {
                 JsonReader f = r.object("freckles");
                 a.freckle_spacing = f.number_in("spacing_mm", 0.5, 100.0);

@@ -229,7 +229,7 @@ struct FaceParams {
     struct Albedo {
         double pigment_variation = 0.0, mottling = 0.0;
         std::vector<Flush> flush;
-        double flush_breakup = 0.0, ear_flush = 0.0;
+        double flush_breakup = 0.0, ear_flush = 0.0, ear_fold_shade = 0.0;
         double freckle_spacing = 0.0, freckle_size = 0.0, freckle_strength = 0.0;
         // pore-scale grain: its size (mm) and +- strength
         double pore_size = 1.0, pore_strength = 0.0;

@@ -442,7 +442,17 @@ double FaceShape::hair_height(glm::dvec3 q) const {
     constexpr double h = 1.5;
     const double lx = (hairline(q + glm::dvec3{h, 0.0, 0.0}) - hairline(q - glm::dvec3{h, 0.0, 0.0})) / (2.0 * h);
     const double lz = (hairline(q + glm::dvec3{0.0, 0.0, h}) - hairline(q - glm::dvec3{0.0, 0.0, h})) / (2.0 * h);
-    return (q.y - hairline(q)) / std::sqrt(1.0 + lx * lx + lz * lz);
+    const double raw = q.y - hairline(q);
+    const double along_head = raw / std::sqrt(1.0 + lx * lx + lz * lz);
+    // Far above the line its steepness says nothing: where the side's line
+    // hands over to the front's (sideburn_z) it rises 70 mm in 12 mm of z,
+    // and divided by that slope the crown read as near the hairline there,
+    // a groove in the volume from the crown to the temple (a helmet's
+    // seam). So the plain height, less a band, takes over with distance.
+    constexpr double kBand = 12.0;
+    const double far = raw - kBand;
+    const double k = 2.0;  // a smooth maximum: no crease where they meet
+    return 0.5 * (along_head + far + std::sqrt((along_head - far) * (along_head - far) + k * k));
 }
 
 FaceShape::HairFlow FaceShape::hair_flow(glm::dvec3 q) const {

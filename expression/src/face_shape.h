@@ -126,7 +126,8 @@ public:
     // How far above the hairline a point of the head lies, in mm along the
     // head (negative below it): the height over hairline() divided by the
     // line's steepness, so the band is as wide where the line runs down the
-    // temple as where it crosses the forehead.
+    // temple as where it crosses the forehead; far above the line (over
+    // 12 mm), the plain height less 12 mm, so the crown is never near it.
     double hair_height(glm::dvec3 q) const;
     // Where a point lies in the hair's flow from the crown's whorl: across
     // it (mm round the crown at a typical distance; the whorl's spiral

@@ -419,7 +419,8 @@ Texel Painter::skin(glm::dvec3 q) const {
         const double cheek_line = ax < 28.0 ? -46.0 : mix(-46.0, -14.0, std::min((ax - 28.0) / 34.0, 1.0));
         const double beard = glm::smoothstep(3.0, -9.0, q.y - cheek_line + 4.0 * (noise(q.x * 0.15, q.y * 0.15, 31.0) - 0.5)) *
                              glm::smoothstep(-150.0, -118.0, q.y) * glm::smoothstep(p_.sideburn_z - 25.0, p_.sideburn_z - 5.0, q.z) *
-                             (0.75 + 0.5 * noise(q.x * 1.7, q.y * 1.7, q.z * 1.7));
+                             (0.75 + 0.5 * noise(q.x * 1.7, q.y * 1.7, q.z * 1.7)) *
+                             (ax > 55.0 ? 1.0 - std::min(1.0, s_.ear_relief(q.y, q.z)) : 1.0);  // not on the lobe
         c = tint(c, al.beard_tint, al.beard_amount * beard);
     }
     // The face's own colouring (redness, freckles, lids, lips, brows) fades
@@ -573,9 +574,23 @@ Texel Painter::skin(glm::dvec3 q) const {
         c = blend(side_colour, c, front);
         gloss = mix(side_gloss, gloss, front);
     }
-    // Ears: thin, well perfused, redder than the face beside them.
-    if (ax > 55.0 && s_.ear_relief(q.y, q.z) > 0.0)
-        c = redden(c, al.ear_flush * std::min(1.0, s_.ear_relief(q.y, q.z) / 3.0));
+    // Ears: thin, well perfused, redder than the face beside them, most
+    // in the hollows (concha, scapha, fossa), where the skin is seen through
+    // less light and in its own shadow; the ridges (helix, antihelix,
+    // tragus) a shade lighter. Painted from the relief's curvature, so the
+    // detail map's bump (from this colour) deepens the folds too.
+    if (ax > 55.0) {
+        const double e = s_.ear_relief(q.y, q.z);
+        if (e > 0.0) {
+            constexpr double r = 2.5;  // mm: about a fold's half width
+            const double around = 0.25 * (s_.ear_relief(q.y + r, q.z) + s_.ear_relief(q.y - r, q.z) +
+                                          s_.ear_relief(q.y, q.z + r) + s_.ear_relief(q.y, q.z - r));
+            const double fold = std::clamp((e - around) / 2.0, -1.0, 1.0);  // < 0 hollow, > 0 ridge
+            const double inside = std::min(1.0, e / 3.0);
+            c = redden(c, al.ear_flush * inside * (1.0 + 0.8 * std::max(-fold, 0.0)));
+            c = c * (1.0 + inside * (0.12 * std::max(fold, 0.0) - al.ear_fold_shade * std::max(-fold, 0.0)));
+        }
+    }
     Rgb hc;
     double roots = 0.0;
     const double h = hair(q, &hc, &roots);
