@@ -37,11 +37,26 @@ double capsule_field(glm::dvec3 p, const Capsule& c, double sign) {
     return glm::length(p - (a + ab * t)) - mix(c.radii[0], c.radii[1], t);
 }
 
+// |x| rounded over the band |x| < w (a parabola meeting the two lines with
+// their slopes): smooth across the midline.
+double soft_abs(double x, double w) {
+    const double a = std::abs(x);
+    return a >= w ? a : 0.5 * (a * a / w + w);
+}
+
 double part_field(glm::dvec3 p, const HeadPart& part) {
     if (!part.is_capsule) return ellipsoid_field(p, part.shape);
-    double f = capsule_field(p, part.capsule, 1.0);
-    if (part.capsule.mirror) f = std::min(f, capsule_field(p, part.capsule, -1.0));
-    return f;
+    if (!part.capsule.mirror) return capsule_field(p, part.capsule, 1.0);
+    // A capsule and its mirror image: the nearer of the two is the one on
+    // the point's side, so the pair is the capsule seen from |x|. Its slope
+    // across the midline flips there; the plain minimum of the two was a
+    // crease on x = 0 wherever the pair shaped the surface, a seam down the
+    // throat and chest (the sternocleidomastoids' lower ends) lit on one
+    // side and shaded on the other. Rounded over kMidlineRound mm, the two
+    // join as one smooth hollow or ridge.
+    constexpr double kMidlineRound = 6.0;
+    const double side = part.capsule.from.x + part.capsule.to.x >= 0.0 ? 1.0 : -1.0;
+    return capsule_field({side * soft_abs(p.x, kMidlineRound), p.y, p.z}, part.capsule, 1.0);
 }
 
 // Polynomial smooth minimum: the union of two volumes with a fillet of size k.
