@@ -171,23 +171,44 @@ GLuint upload_srgb_texture(const ImageRGBA8& image) {
                           image.width, image.height, flipped.data());
 }
 
-// The base colour's relief and hair mask (skin_maps.h): RGB half floats,
-// mipmapped (the filtered slopes are those of the filtered height), rows
-// bottom first like the base texture.
-GLuint upload_detail_map(const ImageRGBA8& image, float mean_levels, std::array<float, 2> hair_luminance) {
+// The base colour's relief and hair mask (skin_maps.h), mipmapped (the
+// filtered slopes are those of the filtered height), rows bottom first like
+// the base texture. Eight bits a channel, slopes as 0.5 + 0.5 slope / scale:
+// half floats (8 bytes a texel) made this one fetch cost as much as the rest
+// of the relief's shading on the H100 (docs/PERFORMANCE.md, session 7).
+struct DetailMap {
+    GLuint texture = 0;
+    float slope_scale = 0.0f;  // the slope a channel's 1 stands for
+};
+DetailMap upload_detail_map(const ImageRGBA8& image, float mean_levels, std::array<float, 2> hair_luminance) {
     const std::vector<float> slopes = detail::albedo_detail_slopes(image, mean_levels, hair_luminance);
-    return upload_texture({GL_RGB16F, GL_RGB, GL_FLOAT, 4, true, GL_CLAMP_TO_EDGE,
-                           "uploading a base texture's relief"},
-                          image.width, image.height, slopes.data());
+    float scale = 0.0f;
+    for (std::size_t i = 0; i < slopes.size(); i += 3)
+        scale = std::max({scale, std::abs(slopes[i]), std::abs(slopes[i + 1])});
+    if (scale == 0.0f) scale = 1.0f;
+    std::vector<std::uint8_t> texels(slopes.size() / 3 * 4);
+    auto unorm = [](float x) { return std::uint8_t(std::lround(255.0f * std::clamp(x, 0.0f, 1.0f))); };
+    for (std::size_t i = 0, j = 0; i < slopes.size(); i += 3, j += 4) {
+        texels[j] = unorm(0.5f + 0.5f * slopes[i] / scale);
+        texels[j + 1] = unorm(0.5f + 0.5f * slopes[i + 1] / scale);
+        texels[j + 2] = unorm(slopes[i + 2]);
+        texels[j + 3] = 255;
+    }
+    return {upload_texture({GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, 1, true, GL_CLAMP_TO_EDGE,
+                            "uploading a base texture's relief"},
+                           image.width, image.height, texels.data()),
+            scale};
 }
 
-// The pre-integrated scattering table: clamped, bilinear, RGB half floats.
+// The pre-integrated scattering table: clamped, bilinear, packed unsigned
+// floats (32 bits a texel: the skin shader samples it five times, and a
+// 64-bit texel filters at half rate).
 constexpr int kScatterTableWidth = 128;   // N.L
 constexpr int kScatterTableHeight = 64;   // curvature
 GLuint upload_scatter_table(const SkinShading& skin) {
     const std::vector<float> table =
         detail::preintegrated_scatter_table(skin, kScatterTableWidth, kScatterTableHeight);
-    return upload_texture({GL_RGB16F, GL_RGB, GL_FLOAT, 4, false, GL_CLAMP_TO_EDGE,
+    return upload_texture({GL_R11F_G11F_B10F, GL_RGB, GL_FLOAT, 4, false, GL_CLAMP_TO_EDGE,
                            "uploading the scattering table"},
                           kScatterTableWidth, kScatterTableHeight, table.data());
 }
@@ -210,6 +231,7 @@ struct Renderer::Impl {
         // The skin's relief baked from the base texture, made on the first
         // skin draw and again when the mean it is taken against changes.
         GLuint detail_texture = 0;
+        float detail_slope_scale = 0.0f;
         float detail_levels = 0.0f;
         std::array<float, 2> detail_hair{};  // the hair mask's luminance range it was made with
         GLuint vao = 0, shape_vbo = 0, frame_vbo = 0, static_vbo = 0, ebo = 0;
@@ -588,6 +610,7 @@ void Renderer::draw(const DrawOptions& o, const WrinkleTexture* wrinkle_map) {
     glUniform1i(im.loc.wrinkle_signed,
                 wrinkle_map && wrinkle_map->encoding() == NormalEncoding::Signed);
     const bool skin_model = o.shading == Shading::Skin;
+    const float albedo_bump = o.skin.albedo_bump_mm / o.skin.mm_per_unit;
     glUniform1i(im.loc.skin_model, skin_model ? 1 : 0);
     if (skin_model) {
         const SkinShading& k = o.skin;
@@ -596,11 +619,10 @@ void Renderer::draw(const DrawOptions& o, const WrinkleTexture* wrinkle_map) {
         glUniform1i(im.loc.pore_map, 3);
         glUniform1f(im.loc.max_curvature, k.max_curvature);
         glUniform1f(im.loc.mm_per_unit, k.mm_per_unit);
-        glUniform3fv(im.loc.normal_softening, 1, glm::value_ptr(k.normal_softening));
+        glUniform2fv(im.loc.normal_softening, 1, glm::value_ptr(k.normal_softening));
         glUniform1f(im.loc.cavity_direct, k.cavity_direct);
         glUniform1f(im.loc.pore_tiles, k.pore_tiles);
         glUniform1f(im.loc.pore_strength, k.pore_strength);
-        glUniform1f(im.loc.albedo_bump, k.albedo_bump_mm / k.mm_per_unit);
         glUniform1i(im.loc.detail_map, 4);
         glActiveTexture(GL_TEXTURE4);
         for (auto& m : im.meshes) {
@@ -608,9 +630,10 @@ void Renderer::draw(const DrawOptions& o, const WrinkleTexture* wrinkle_map) {
             if (!wanted || (m.detail_texture && m.detail_levels == k.albedo_bump_bias &&
                             m.detail_hair == k.hair_luminance))
                 continue;
-            const GLuint t = upload_detail_map(*m.material.base_texture, k.albedo_bump_bias, k.hair_luminance);
+            const DetailMap d = upload_detail_map(*m.material.base_texture, k.albedo_bump_bias, k.hair_luminance);
             if (m.detail_texture) glDeleteTextures(1, &m.detail_texture);
-            m.detail_texture = t;
+            m.detail_texture = d.texture;
+            m.detail_slope_scale = d.slope_scale;
             m.detail_levels = k.albedo_bump_bias;
             m.detail_hair = k.hair_luminance;
         }
@@ -626,9 +649,9 @@ void Renderer::draw(const DrawOptions& o, const WrinkleTexture* wrinkle_map) {
         glUniform3f(im.loc.hair, k.hair_wrap, k.hair_roughness, k.hair_sheen);
         glUniform4f(im.loc.wet, k.wet_f0, k.wet_broad_roughness, k.wet_broad_weight, k.wet_tight_scale);
         glUniform3fv(im.loc.key_tint, 1, glm::value_ptr(k.key_tint));
-        glUniform3fv(im.loc.fill_direction, 1, glm::value_ptr(k.fill.direction));
+        glUniform3fv(im.loc.fill_direction, 1, glm::value_ptr(glm::normalize(k.fill.direction)));
         glUniform3fv(im.loc.fill_colour, 1, glm::value_ptr(k.fill.colour));
-        glUniform3fv(im.loc.rim_direction, 1, glm::value_ptr(k.rim.direction));
+        glUniform3fv(im.loc.rim_direction, 1, glm::value_ptr(glm::normalize(k.rim.direction)));
         glUniform3fv(im.loc.rim_colour, 1, glm::value_ptr(k.rim.colour));
         glUniform3fv(im.loc.sky, 1, glm::value_ptr(k.sky));
         glUniform3fv(im.loc.ground, 1, glm::value_ptr(k.ground));
@@ -647,6 +670,7 @@ void Renderer::draw(const DrawOptions& o, const WrinkleTexture* wrinkle_map) {
         if (skin_model) {
             glActiveTexture(GL_TEXTURE4);
             glBindTexture(GL_TEXTURE_2D, m.detail_texture);
+            glUniform1f(im.loc.albedo_bump, m.detail_texture ? albedo_bump * m.detail_slope_scale : 0.0f);
         }
         glActiveTexture(GL_TEXTURE0);
         glBindTexture(GL_TEXTURE_2D, m.base_texture);

@@ -62,7 +62,7 @@ void main() {
 //   skin:   pre-integrated scattering, two GGX lobes with Fresnel, pores,
 //           cavity and specular occlusion, a key/fill/rim/hemisphere rig
 //           (the full model for the key light; fill and rim reduced to
-//           one table lookup and one GGX lobe),
+//           wrapped Lambert and one GGX lobe),
 //           exposure and tone mapping, then the same sRGB encoding.
 // Light intensities follow the thesis's convention: a light of colour I
 // lights a white Lambert surface facing it to I (I = E / pi), so a BRDF f
@@ -96,13 +96,13 @@ uniform bool u_skin_surface;        // this mesh is skin (else a wet, glossy par
 uniform sampler2D u_scatter_table;  // N.L x curvature -> rgb diffuse
 uniform float u_max_curvature;      // 1/mm at the table's top row
 uniform float u_mm_per_unit;
-uniform vec3 u_normal_softening;
+uniform vec2 u_normal_softening;   // red; green and blue
 uniform float u_cavity_direct;
 uniform sampler2D u_pore_map;       // rgb normal, a cavity
 uniform float u_pore_tiles;
 uniform float u_pore_strength;
-uniform sampler2D u_detail_map;     // rg: the base colour's relief, slopes per base UV; b: hair (skin_maps.h)
-uniform float u_albedo_bump;        // detail height (scene units) per unit of the relief
+uniform sampler2D u_detail_map;     // rg: the base colour's relief, 0.5 + 0.5 slope per base UV; b: hair (skin_maps.h)
+uniform float u_albedo_bump;        // detail height (scene units) per unit of the relief, x the map's slope scale
 uniform float u_f0;
 uniform vec2 u_roughness;
 uniform float u_lobe_weight;
@@ -115,7 +115,7 @@ uniform float u_wrap;               // the rig lights' softness (wrapped N.L, en
 uniform vec3 u_hair;                // hair: wrap, roughness, the lights' sheen
 uniform vec4 u_wet;                 // eyes, mouth: F0, broad lobe's roughness, its weight, tight lobe's scale
 uniform vec3 u_key_tint;
-uniform vec3 u_fill_direction;
+uniform vec3 u_fill_direction;     // unit vectors
 uniform vec3 u_fill_colour;
 uniform vec3 u_rim_direction;
 uniform vec3 u_rim_colour;
@@ -148,14 +148,14 @@ float fresnel(float f0, float cos_theta) {
     return f0 + (1.0 - f0) * m2 * m2 * m;
 }
 
-// GGX D times the height-correlated Smith visibility G / (4 N.L N.V).
+// GGX D times the height-correlated Smith visibility G / (4 N.L N.V), the
+// latter in Hammon's linear fit (2017): no square roots, within a few
+// per cent of the exact term at the skin's roughness.
 float ggx_dv(float a, float n_dot_h, float n_dot_l, float n_dot_v) {
     float a2 = a * a;
     float d = n_dot_h * n_dot_h * (a2 - 1.0) + 1.0;
     float dist = a2 / (PI * d * d);
-    float gv = n_dot_l * sqrt(n_dot_v * n_dot_v * (1.0 - a2) + a2);
-    float gl = n_dot_v * sqrt(n_dot_l * n_dot_l * (1.0 - a2) + a2);
-    return dist * 0.5 / max(gv + gl, 1e-6);
+    return dist * 0.5 / max(mix(2.0 * n_dot_l * n_dot_v, n_dot_l + n_dot_v, a), 1e-6);
 }
 
 // Split-sum environment BRDF, analytic fit (Karis 2014, "mobile").
@@ -181,7 +181,7 @@ struct Surface {
     vec3 n;          // shading normal (bumped, pores)
     vec3 v;          // towards the eye
     float n_dot_v;
-    vec3 n_r, n_g, n_b;   // per-channel softened diffuse normals (skin)
+    vec3 n_r, n_g;   // softened diffuse normals (skin): red; green and blue
     vec3 diffuse_albedo;  // albedo x the diffuse share (1 - sheen)
     float direct_cavity;  // the cavity's dimming of direct diffuse light
     float curvature; // table row coordinate in [0, 1]
@@ -199,10 +199,11 @@ struct Surface {
 
 // One light's contribution (colour `c`, direction `l` towards it). `full`
 // (a constant at each call, so the compiler drops the other branch): the
-// key light's model, each channel's softened normal looked up in the
-// scattering table and the two GGX lobes. Otherwise the dim lights' (fill,
-// rim) reduced model: one lookup at the green channel's softened normal and
-// one lobe standing for both.
+// key light's model, red's and green-blue's softened normals looked up in
+// the scattering table and the two GGX lobes. Otherwise the dim lights'
+// (fill, rim) reduced model: wrapped Lambert at the green-blue softened
+// normal (what the table's flattest row holds) and one lobe standing for
+// both.
 // The rig's lights are soft boxes, not points: N.L is wrapped by w,
 // (N.L + w) / (1 + w), and the result divided by 1 + w so that the light
 // a surface gets over all directions stays the same (the terminator moves
@@ -227,21 +228,26 @@ vec3 shade_light(Surface s, vec3 l, vec3 c, const bool full) {
     if (u_skin_surface) {
         float wrap_scale = 1.0 / (1.0 + u_wrap);
         if (full) {
-            vec3 n_dot_l = (vec3(dot(s.n_r, l), dot(s.n_g, l), dot(s.n_b, l)) + u_wrap) * wrap_scale;
-            vec3 u = clamp(0.5 + 0.5 * n_dot_l, 0.0, 1.0);
-            diffuse = vec3(textureLod(u_scatter_table, vec2(u.r, s.curvature), 0.0).r,
-                           textureLod(u_scatter_table, vec2(u.g, s.curvature), 0.0).g,
-                           textureLod(u_scatter_table, vec2(u.b, s.curvature), 0.0).b);
+            vec2 n_dot_l = (vec2(dot(s.n_r, l), dot(s.n_g, l)) + u_wrap) * wrap_scale;
+            vec2 u = clamp(0.5 + 0.5 * n_dot_l, 0.0, 1.0);
+            // Green and blue share a softened normal and so one lookup.
+            vec3 green_blue = textureLod(u_scatter_table, vec2(u.y, s.curvature), 0.0).rgb;
+            diffuse = vec3(textureLod(u_scatter_table, vec2(u.x, s.curvature), 0.0).r, green_blue.gb);
             diffuse *= wrap_scale * visible;
         } else {
-            float u = clamp(0.5 + 0.5 * (dot(s.n_g, l) + u_wrap) * wrap_scale, 0.0, 1.0);
-            diffuse = textureLod(u_scatter_table, vec2(u, s.curvature), 0.0).rgb * (wrap_scale * s.dim_shadow);
+            // The table's flattest row is Lambert to 0.015 (a dim light's
+            // red terminator is not seen), so no lookup.
+            diffuse = vec3(clamp((dot(s.n_g, l) + u_wrap) * wrap_scale, 0.0, 1.0) * (wrap_scale * s.dim_shadow));
         }
-        // Hair scatters no light under its surface: wrapped Lambert.
-        float hair_wrap_scale = 1.0 / (1.0 + u_hair.x);
-        float lambert = max(dot(s.n, l) + u_hair.x, 0.0) * hair_wrap_scale * hair_wrap_scale *
-                        (full ? visible : s.dim_shadow);
-        diffuse = mix(diffuse, vec3(lambert), s.hair) * s.direct_cavity;
+        // Hair scatters no light under its surface: wrapped Lambert. A
+        // branch, since most of the face is skin (coherent over a warp).
+        if (s.hair > 0.0) {
+            float hair_wrap_scale = 1.0 / (1.0 + u_hair.x);
+            float lambert = max(dot(s.n, l) + u_hair.x, 0.0) * hair_wrap_scale * hair_wrap_scale *
+                            (full ? visible : s.dim_shadow);
+            diffuse = mix(diffuse, vec3(lambert), s.hair);
+        }
+        diffuse *= s.direct_cavity;
     } else {
         diffuse = vec3(max(dot(s.n, l), 0.0));
     }
@@ -319,14 +325,16 @@ vec3 shade_skin(vec3 n_bumped, vec3 n_geo, vec3 base, float cavity, float gloss,
         // Curvature of the geometric surface (Penner): |dN| / |dP| in 1/mm,
         // at least the flattest skin's (light scatters a few mm in red even
         // where the surface is flat at that scale: a red, soft terminator).
-        float dn = length(fwidth(n_geo));
-        float dp = length(fwidth(v_position)) * u_mm_per_unit;
-        s.curvature = clamp(dn / max(dp, 1e-6) / u_max_curvature, u_min_curvature, 1.0);
+        // Rates over both screen axes as sums of squares (the Frobenius
+        // norms of dN and dP: one square root; dp1, dp2 are the pores').
+        vec3 dn1 = dFdx(n_geo), dn2 = dFdy(n_geo);
+        float dn = dot(dn1, dn1) + dot(dn2, dn2);
+        float dp = (dot(dp1, dp1) + dot(dp2, dp2)) * (u_mm_per_unit * u_mm_per_unit);
+        s.curvature = clamp(sqrt(dn / max(dp, 1e-12)) / u_max_curvature, u_min_curvature, 1.0);
         // Each channel sees a normal softened towards the geometric one;
         // the same for every light, so made once here.
-        s.n_r = normalize(mix(s.n, n_geo, u_normal_softening.r));
-        s.n_g = normalize(mix(s.n, n_geo, u_normal_softening.g));
-        s.n_b = normalize(mix(s.n, n_geo, u_normal_softening.b));
+        s.n_r = normalize(mix(s.n, n_geo, u_normal_softening.x));
+        s.n_g = normalize(mix(s.n, n_geo, u_normal_softening.y));
     } else {
         // Eyes, mouth: wet. A tight lobe, sharper than the roughness that
         // matches the Blinn-Phong exponent (Walter et al. 2007: alpha =
@@ -337,7 +345,7 @@ vec3 shade_skin(vec3 n_bumped, vec3 n_geo, vec3 base, float cavity, float gloss,
         s.lobe_weight = 1.0 - u_wet.z;
         s.f0 = u_wet.x;
         s.n = n_bumped;
-        s.n_r = s.n_g = s.n_b = s.n;
+        s.n_r = s.n_g = s.n;
         s.curvature = 0.0;
     }
     s.alpha = max(roughness * roughness, vec2(1e-3));
@@ -365,8 +373,8 @@ vec3 shade_skin(vec3 n_bumped, vec3 n_geo, vec3 base, float cavity, float gloss,
     vec3 key = u_light_position.w == 0.0 ? normalize(u_light_position.xyz)
                                          : normalize(u_light_position.xyz - v_position);
     vec3 color = shade_light(s, key, u_light_diffuse * u_key_tint, true);
-    color += shade_light(s, normalize(u_fill_direction), u_fill_colour, false);
-    color += shade_light(s, normalize(u_rim_direction), u_rim_colour, false);
+    color += shade_light(s, u_fill_direction, u_fill_colour, false);
+    color += shade_light(s, u_rim_direction, u_rim_colour, false);
 
     // The sky/ground hemisphere: diffuse from the softest normal, specular
     // by the environment BRDF towards the reflection, both occluded.
@@ -408,7 +416,7 @@ void main() {
             gloss = texel.a;
             if (u_skin_surface && u_albedo_bump > 0.0) {
                 vec3 detail = texture(u_detail_map, v_base_uv).rgb;
-                slope = (u_albedo_bump / u_pore_tiles) * detail.rg;
+                slope = (u_albedo_bump / u_pore_tiles) * (detail.rg * 2.0 - 1.0);
                 hair = detail.b;
             }
         }

@@ -47,10 +47,11 @@ SkinShading load_skin_shading(const std::string& path) {
         s.max_curvature = float(scatter.number_in("max_curvature_per_mm", 1e-3, 10.0));
         s.min_curvature = float(scatter.number_in("min_curvature_per_mm", 0.0, s.max_curvature));
         s.mm_per_unit = float(scatter.number_in("mm_per_unit", 1e-6, 1e6));
-        s.normal_softening = vec3_at(scatter, "normal_softening");
-        for (int c = 0; c < 3; ++c)
+        const auto softening = scatter.numbers<2>("normal_softening");
+        s.normal_softening = {float(softening[0]), float(softening[1])};
+        for (int c = 0; c < 2; ++c)
             if (s.normal_softening[c] < 0.0f || s.normal_softening[c] > 1.0f)
-                scatter.at("normal_softening").fail("three numbers in [0, 1]");
+                scatter.at("normal_softening").fail("two numbers in [0, 1] (red; green and blue)");
         s.cavity_direct = float(scatter.number_in("cavity_direct", 0.0, 1.0));
         scatter.finish();
 

@@ -24,6 +24,7 @@
 #include "emoface/render/skin_shading.h"
 #include "emoface/render/wrinkle_texture.h"
 #include "quad_mesh.h"
+#include "skin_maps.h"
 
 namespace {
 
@@ -705,6 +706,76 @@ TEST_F(SkinQuad, OcclusionDimsTheSkyAndItsSheen) {
     EXPECT_GT(shut.g, 0.0f);
     EXPECT_GT(open_sheen, 0.0f);
     EXPECT_LT(shut_sheen, 0.5f * open_sheen) << "and its sheen";
+}
+
+// The key's contact shadow (shaders.cpp, u_key_cone): an occluded point is
+// open to a cone that leans down from its normal (a face's occluders lie
+// above), so a grazing key from above is dimmed by up to occlusion.key, the
+// same key from below less, a key the surface faces is not dimmed at all,
+// and an open point (occlusion 1) never is. The thesis shading ignores it.
+TEST_F(SkinQuad, KeyContactShadowFollowsTheOcclusionsCone) {
+    const SkinShading skin = dark_rig();
+    Material m;
+    m.uses_wrinkle_map = true;  // a skin surface
+    m.base_color = glm::vec3(0.5f);
+    const std::size_t n = make_quad(UvLayout::VUp).n_vertices();
+    const float graze = glm::radians(75.0f);
+    auto lit = [&](float occlusion, glm::vec3 towards, Shading shading = Shading::Skin) {
+        renderer_->set_occlusion(white_, std::vector<float>(n, occlusion));
+        Light key = directional(towards);
+        if (shading == Shading::Skin) return draw(m, 0.0f, key, skin).g;
+        renderer_->set_material(white_, m);
+        DrawOptions d;
+        d.camera.position = {0.0f, 0.0f, 50.0f};
+        d.camera.view = glm::lookAt(d.camera.position, glm::vec3(0), glm::vec3(0, 1, 0));
+        d.camera.projection = glm::ortho(-1.0f, 1.0f, -1.0f, 1.0f, 40.0f, 60.0f);
+        d.model = glm::scale(glm::mat4(1.0f), glm::vec3(2.0f, 24.0f, 1.0f));
+        d.light = key;
+        d.shading = shading;
+        platform_->begin_frame();
+        renderer_->draw(d, nullptr);
+        platform_->end_frame();
+        return srgb_to_linear(platform_->read_rgba().at(kSkinFrame / 2, kSkinFrame / 2)[1] / 255.0f);
+    };
+    const glm::vec3 above(0.0f, std::sin(graze), std::cos(graze)), below(0.0f, -std::sin(graze), std::cos(graze));
+    const glm::vec3 facing(0.0f, 0.0f, 1.0f);
+    const float open_above = lit(1.0f, above), shut_above = lit(0.3f, above);
+    const float open_below = lit(1.0f, below), shut_below = lit(0.3f, below);
+    const float open_facing = lit(1.0f, facing), shut_facing = lit(0.3f, facing);
+    const float thesis_open = lit(1.0f, above, Shading::Thesis), thesis_shut = lit(0.3f, above, Shading::Thesis);
+    renderer_->set_occlusion(white_, std::vector<float>(n, 1.0f));  // the other tests' quad: open
+    ASSERT_GT(open_above, 0.01f);
+    // Occlusion 0.3: the cone's cos is capped at key_cone_max 0.5; from
+    // above, N.L 0.26 less the lean lies below the 0.3-wide ramp: 1 - 0.4.
+    EXPECT_NEAR(shut_above / open_above, 1.0f - skin.occlusion_key, 0.06f) << "a grazing key from above";
+    EXPECT_GT(shut_below / open_below, shut_above / open_above + 0.1f) << "the cone leans down";
+    EXPECT_LT(shut_below / open_below, 0.97f);
+    EXPECT_NEAR(shut_facing / open_facing, 1.0f, 0.02f) << "skin facing the key stays lit";
+    EXPECT_NEAR(thesis_shut, thesis_open, 1e-6f) << "the thesis's Blinn-Phong has no occlusion";
+}
+
+// The dim lights (fill, rim) shade with wrapped Lambert instead of the
+// scattering table (shaders.cpp): that holds while the table's flattest row,
+// where most of the face is looked up, is Lambert.
+TEST(SkinMaps, ScatterTablesFlattestRowIsLambert) {
+    constexpr int kWidth = 128, kHeight = 64;
+    const SkinShading skin;
+    const std::vector<float> table = emoface::render::detail::preintegrated_scatter_table(skin, kWidth, kHeight);
+    const int row = int(skin.min_curvature / skin.max_curvature * kHeight);
+    float worst = 0.0f;
+    for (int i = 0; i < kWidth; ++i) {
+        const float n_dot_l = -1.0f + 2.0f * (i + 0.5f) / kWidth;
+        for (int c = 0; c < 3; ++c)
+            worst = std::max(worst, std::abs(table[(std::size_t(row) * kWidth + i) * 3 + c] - std::max(n_dot_l, 0.0f)));
+    }
+    EXPECT_LT(worst, 0.03f) << "row " << row;
+    // ... and is not at the top row: the key's lookups are not Lambert there.
+    float top = 0.0f;
+    for (int i = 0; i < kWidth; ++i) {
+        const float n_dot_l = -1.0f + 2.0f * (i + 0.5f) / kWidth;
+        top = std::max(top, std::abs(table[(std::size_t(kHeight - 1) * kWidth + i) * 3] - std::max(n_dot_l, 0.0f)));
+    }
+    EXPECT_GT(top, 2.0f * worst) << "top row " << top << ", flattest " << worst;
 }
 
 // SkinShading's defaults are data/render/skin.json's values.

@@ -31,6 +31,7 @@
 #include <array>
 #include <string>
 
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 namespace emoface::render {
@@ -96,9 +97,10 @@ struct SkinShading {
     float min_curvature = 0.1f;
     // Millimetres per scene unit (the default face is modelled in mm).
     float mm_per_unit = 1.0f;
-    // How far each channel's diffuse normal leans from the bumped normal to
-    // the geometric one (Penner's softened normals: red scatters farthest).
-    glm::vec3 normal_softening{0.5f, 0.2f, 0.1f};
+    // How far the diffuse normal leans from the bumped normal to the
+    // geometric one (Penner's softened normals: red scatters farthest), for
+    // red and for green and blue (one lookup of the table for both).
+    glm::vec2 normal_softening{0.5f, 0.2f};
     // How much the wrinkle cavity darkens direct diffuse light (ambient light
     // is darkened fully).
     float cavity_direct = 0.9f;
