@@ -136,14 +136,15 @@ std::array<double, 3> eye_colour(const FaceShape& shape, double polar, double az
     // The upper lid's shadow on the eyeball where it rests on it, soft
     // (the lid stands off the eye by its thickness, and the lashes and the
     // lid's edge both shade it; the key light is above), and a fainter one
-    // under the lower lid. It fades out above the upper lid's rest margin:
-    // the tile is fixed to the eyeball, so a shadow painted there showed as
-    // a grey band on the white that a raised lid (AU5: fear, surprise)
-    // bares, where the lid no longer is.
+    // under the lower lid. The tile is fixed to the eyeball, so the shade
+    // cannot follow a raised lid (AU5: fear, surprise); it ramps up to the
+    // rest margin and holds above it, where the lid and brow overhang the
+    // eyeball in every pose. Faded out above the margin it drew a grey band
+    // at the rest margin's height; gone above it, the bared white glowed as
+    // a bright band between lid and iris: a googly, pasted-in eye.
     const double upper_margin = shape.eye.upper(cx + x) - cy;
     const double lower_margin = shape.eye.lower(cx + x) - cy;
-    const double from_upper = glm::smoothstep(upper_margin - 3.5, upper_margin + 0.3, y) *
-                              (1.0 - glm::smoothstep(upper_margin + 0.3, upper_margin + 2.0, y));
+    const double from_upper = glm::smoothstep(upper_margin - 3.5, upper_margin + 0.3, y);
     const double shade = p.lid_shadow * from_upper * (0.6 + 0.4 * from_upper) +
                          0.35 * p.lid_shadow * glm::smoothstep(lower_margin + 1.5, lower_margin - 0.5, y);
     // The corners are deeper in the socket.

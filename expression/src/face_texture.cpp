@@ -548,13 +548,25 @@ Texel Painter::skin(glm::dvec3 q) const {
             if (strip > 0.0) {
                 c = blend(c, from255(al.lid_margin), 0.85 * strip);
                 gloss = mix(gloss, p_.gloss.lid_margin, strip);
+                // The margin's posterior edge, where it rests on the eyeball:
+                // wet conjunctiva in the lid's own shade, a dark line that
+                // moves with the lid (the eyeball's tile cannot follow it).
+                // The lit pink strip ran straight into the white as a pale
+                // band, the eye "pasted in" (blind review, issue 11).
+                const double contact = strip * (1.0 - glm::smoothstep(p_.lid_clearance + 0.15 * p_.lid_thickness,
+                                                                      p_.lid_clearance + 0.5 * p_.lid_thickness, shell));
+                c = blend(c, from255(al.lid_margin) * Rgb{0.52, 0.42, 0.42}, 0.75 * contact);
+                gloss = mix(gloss, p_.gloss.tear_line, contact);
                 // The tear meniscus: along the lower margin where it meets the eyeball.
                 const double tear = (1.0 - glm::smoothstep(p_.lid_clearance + 0.1, p_.lid_clearance + 0.6, shell)) *
                                     (dy_lo > -1.5 && q.y < e.slit(ax) ? 1.0 : 0.0) * along;
                 gloss = mix(gloss, p_.gloss.tear_line, tear);
-                // The caruncle in the inner corner, on the deep part only.
-                const double car = (1.0 - glm::smoothstep(0.6, 2.2, std::hypot(ax - e.x_in - 0.6, q.y - e.y_in)));
-                c = blend(c, Rgb{0.8, 0.5, 0.48}, 0.6 * car * strip);
+                // The caruncle in the inner corner, on the deep part only: a
+                // moist pink mound about 3 mm across. At 0.6 of a duller pink
+                // over 2 mm it vanished in the corner's shade and the white
+                // ran into a grey corner (blind review: eyes "pasted in").
+                const double car = (1.0 - glm::smoothstep(0.8, 2.8, std::hypot(ax - e.x_in - 0.9, q.y - e.y_in)));
+                c = blend(c, Rgb{0.86, 0.5, 0.47}, 0.85 * car * strip);
                 gloss = mix(gloss, p_.gloss.tear_line, car * strip);
             }
         }

@@ -103,6 +103,8 @@ TEST(Eyelids, MarginsSitOnTheIrisAtRestAndMoveWithTheLidAus) {
     for (const Case& c : cases) {
         SCOPED_TRACE(c.what);
         const LidReading r = c.au == 0 ? rest : read_lids(au_faps(c.au));
+        std::printf("%-22s upper cover %+.2f IRISD, lower cover %+.2f IRISD, lower lid rise %+.2f IRISD\n", c.what,
+                    r.upper_cover, r.lower_cover, r.lower - rest.lower);
         EXPECT_GE(r.upper_cover, c.upper_min);
         EXPECT_LE(r.upper_cover, c.upper_max);
         EXPECT_GE(r.lower_cover, c.lower_min);
@@ -160,10 +162,13 @@ TEST(Eyelids, TheUpperLidsInnerPartFollowsTheInnerBrow) {
 }
 
 // The emotions' lids: fear and surprise bare white above the iris (AU5) but
-// no more than a few millimetres of it, and none below (a white ring reads
-// as a stare; the brows' raise must not carry the upper margin with it);
-// joy's AU6 and anger's AU7 raise the lower lid over the iris; sadness
-// shows next to no white above the iris (its inner lid rises with the brow).
+// only a strip of it, 1-3.5 mm, and none below (a white ring reads as a
+// stare; at 4 mm in surprise a blind observer saw "googly" eyes); joy's AU6
+// narrows the eye, the lower lid well over the iris and the upper one a
+// little lower than at rest (observers saw joy's eyes "barely take part"
+// with 0.27 / 0.15 IRISD); anger's AU7 raises the lower lid over the iris;
+// sadness shows next to no white above the iris (its inner lid rises with
+// the brow).
 TEST(Eyelids, EmotionsShowWhiteAboveTheIrisOnlyWhereTheirAusSaySo) {
     constexpr double kAny = 1e9;
     struct Case {
@@ -171,12 +176,12 @@ TEST(Eyelids, EmotionsShowWhiteAboveTheIrisOnlyWhereTheirAusSaySo) {
         double upper_min, upper_max, lower_min, lower_max;
     };
     const Case cases[] = {
-        {Emotion::Joy, 0.1, kAny, 0.2, kAny},
+        {Emotion::Joy, 0.17, kAny, 0.29, kAny},
         {Emotion::Sadness, -0.05, kAny, 0.0, kAny},
         {Emotion::Anger, 0.0, kAny, 0.1, kAny},
-        {Emotion::Fear, -0.35, -0.1, 0.0, kAny},
+        {Emotion::Fear, -0.2, -0.08, 0.0, kAny},
         {Emotion::Disgust, 0.1, kAny, 0.1, kAny},
-        {Emotion::Surprise, -0.45, -0.15, 0.0, kAny},
+        {Emotion::Surprise, -0.3, -0.12, 0.0, kAny},
     };
     for (const Case& c : cases) {
         const LidReading r = read_lids(profiles()[c.emotion]);
