@@ -80,6 +80,7 @@ WrinkleSpec read_wrinkle(JsonReader item) {
     w.depth_falloff = read_number(item, "depth_falloff", 1.0f, 0.0f, 2.0f);
     w.side = read_number(item, "side", 1.0f, -1.0f, 1.0f) < 0.0f ? -1.0f : 1.0f;
     w.shoulder = item.has("shoulder") ? read_number(item, "shoulder", 0.0f, 0.0f, 1.0f) : -1.0f;
+    w.asymmetry = item.has("asymmetry") ? read_number(item, "asymmetry", 0.0f, 0.0f, 0.8f) : -1.0f;
     item.finish();
     return w;
 }
@@ -93,7 +94,7 @@ struct Stroke {
     std::vector<float> arc;  // cumulative arc length at each polyline vertex
     std::vector<float> keep;  // depth factor at each vertex (1; less near the hairline)
     std::vector<float> along;  // the points' depth_factor at each vertex (depth and width)
-    float depth, sigma, taper, taper_end, crease, side, shoulder;
+    float depth, sigma, taper, taper_end, crease, side, shoulder, asymmetry;
     float swell_phase;  // where along the swell noise this stroke starts
     bool fine;          // a fine secondary line: a plain valley, no shoulders
     float split = 0.0f;  // +1 / -1: only the face's left / right half of it (an `across` wrinkle on one side)
@@ -209,7 +210,7 @@ std::vector<glm::vec2> displace(const std::vector<glm::vec2>& line, OffsetFn&& o
 
 Stroke make_stroke(WrinkleProfile profile, std::vector<glm::vec2> polyline, std::vector<float> along, float depth,
                    float sigma, float taper, float taper_end, float crease, float side, float shoulder,
-                   float swell_phase, bool fine, float reach) {
+                   float asymmetry, float swell_phase, bool fine, float reach) {
     Stroke s;
     s.profile = profile;
     s.polyline = std::move(polyline);
@@ -218,6 +219,7 @@ Stroke make_stroke(WrinkleProfile profile, std::vector<glm::vec2> polyline, std:
     s.along = std::move(along);
     s.along.resize(s.polyline.size(), 1.0f);
     s.shoulder = shoulder;
+    s.asymmetry = asymmetry;
     s.depth = depth;
     s.sigma = sigma;
     s.taper = taper;
@@ -283,9 +285,10 @@ void resolve_strokes(const std::vector<WrinkleSpec>& specs, const FoldShape& sha
         const float taper_end = spec.taper_end < 0.0f ? spec.taper : spec.taper_end;
         const float crease = spec.crease < 0.0f ? shape.core : spec.crease;
         const float shoulder = spec.shoulder < 0.0f ? shape.shoulder : spec.shoulder;
+        const float asymmetry = spec.asymmetry < 0.0f ? shape.asymmetry : spec.asymmetry;
         const DepthAlong depth_along(spec, curve);
         // A valley with its shoulders on the wide flank reaches this far.
-        const float wide = 1.0f + shape.asymmetry;
+        const float wide = 1.0f + asymmetry;
         const float reach = std::max(spec.profile == WrinkleProfile::Fold
                                          ? 8.5f * sigma
                                          : (shape.shoulder_offset + 3.0f * shape.shoulder_width) * wide * sigma,
@@ -293,7 +296,7 @@ void resolve_strokes(const std::vector<WrinkleSpec>& specs, const FoldShape& sha
         if (curve.size() == 1) {  // a round mark: no along-the-fold shape
             strokes.push_back(make_stroke(spec.profile, curve, {spec.points[0].depth_factor},
                                           scale * spec.depth * unit, sigma, 0.0f, 0.0f, crease, spec.side, shoulder,
-                                          0.0f, false, 3.0f * sigma));
+                                          asymmetry, 0.0f, false, 3.0f * sigma));
             continue;
         }
         const bool varied = spec.count > 1;
@@ -327,12 +330,12 @@ void resolve_strokes(const std::vector<WrinkleSpec>& specs, const FoldShape& sha
                 strokes.push_back(make_stroke(WrinkleProfile::Groove, std::move(fine),
                                               depth_along.sample(f0, f1, kSamples),
                                               shape.fine_depth * copy_depth * unit, shape.fine_width * sigma, 0.4f,
-                                              0.4f, 0.0f, spec.side, 0.0f, phase + 13.0f, true,
+                                              0.4f, 0.0f, spec.side, 0.0f, asymmetry, phase + 13.0f, true,
                                               3.0f * shape.fine_width * sigma));
             }
             strokes.push_back(make_stroke(spec.profile, std::move(line), depth_along.sample(u0, u1, kSamples),
                                           copy_depth * unit, sigma, spec.taper, taper_end, crease, spec.side,
-                                          shoulder, phase, false, reach));
+                                          shoulder, asymmetry, phase, false, reach));
         }
     }
     for (std::size_t i = first; i < strokes.size(); ++i) strokes[i].split = split;
@@ -388,7 +391,7 @@ float stroke_height(const Stroke& s, const FoldShape& shape, float unit, glm::ve
     if (s.fine) return -depth * bump(best, sigma);
     // Across: the flank on the `side` of the curve is steeper than the other.
     const bool steep = s.side * signed_best >= 0.0f;
-    const float flank = sigma * (steep ? 1.0f - shape.asymmetry : 1.0f + shape.asymmetry);
+    const float flank = sigma * (steep ? 1.0f - s.asymmetry : 1.0f + s.asymmetry);
     // The valley: a sharp narrow core (dark in its cavity) in broad shallow
     // walls, so the wall that faces the light catches little of it.
     const float valley = s.crease * bump(best, shape.core_width * flank) +
@@ -399,7 +402,7 @@ float stroke_height(const Stroke& s, const FoldShape& shape, float unit, glm::ve
             // Compressed skin buckles into a narrow valley with broad rounded
             // crests beside it (FIDELITY.md 6, HARR).
             // The skin bunches higher beside the steep flank than the gentle one.
-            return depth * (-valley + s.shoulder * (steep ? 1.0f + 0.5f * shape.asymmetry : 1.0f - 0.5f * shape.asymmetry) *
+            return depth * (-valley + s.shoulder * (steep ? 1.0f + 0.5f * s.asymmetry : 1.0f - 0.5f * s.asymmetry) *
                                           bump(best - shape.shoulder_offset * flank, shape.shoulder_width * flank));
         case WrinkleProfile::Bulge:
             return depth * bump(best, sigma);

@@ -58,6 +58,8 @@ struct WrinkleSpec {
     float side = 1.0f;     // Fold: which side of the curve bulges (+1 left of travel)
     float shoulder = -1.0f;  // crest height of the bunched skin beside it (< 0: FoldShape::shoulder);
                              // high where neighbouring folds share broad rolls (the forehead)
+    float asymmetry = -1.0f;  // how much steeper the `side` flank is (< 0: FoldShape::asymmetry); low
+                              // for a fold the cheek rounds over softly, with no hard edge
 };
 
 // How every groove and fold is shaped, for all wrinkles alike (wrinkles.json
