@@ -306,6 +306,16 @@ FaceParams read_face_params(const std::string& params_dir) {
             p.hair_tip_lightening = r.number_in("tip_lightening", 0.0, 1.0);
             p.hair_swirl = r.number_in("swirl_deg", -180.0, 180.0) * 3.14159265358979323846 / 180.0;
             p.hair_tuft_shade = r.number_in("tuft_shade", 0.0, 0.9);
+            {
+                JsonReader f = r.object("forelock");
+                p.hair_forelock.locks = f.integer_in("locks", 0, 40);
+                p.hair_forelock.strands = f.integer_in("strands", 1, 12);
+                p.hair_forelock.length = to_glm(f.numbers<2>("length_mm"));
+                if (!(p.hair_forelock.length[0] > 0.0 && p.hair_forelock.length[1] >= p.hair_forelock.length[0]))
+                    f.at("length_mm").fail("shortest > 0 and longest >= shortest (mm)");
+                p.hair_forelock.width = f.number_in("width_mm", 0.05, 2.0);
+                f.finish();
+            }
             r.finish();
         }
         {

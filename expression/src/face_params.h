@@ -210,6 +210,14 @@ struct FaceParams {
     // hair: how much darker a parting between tufts is than a tuft's crest
     // (the strands' roots show there, shadowed by the clumps beside it)
     double hair_tuft_shade = 0.0;
+    // hair: stray locks over the forehead, each a few strands from one root
+    // that fan out: how many locks, their length (mm, shortest .. longest),
+    // strands per lock and a strand's width (mm)
+    struct Forelock {
+        int locks = 0, strands = 1;
+        glm::dvec2 length{1.0};
+        double width = 0.1;
+    } hair_forelock;
     // brow hairs: spacing of their roots, length at the inner end and beyond,
     // width (mm), angle off the brow line (degrees) of the medial ones and of
     // the lateral ones above and below the line (which converge on it)

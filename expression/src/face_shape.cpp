@@ -378,11 +378,11 @@ double FaceShape::ear_relief(double y, double z) const {
     const double helix = (1.0 - glm::smoothstep(0.25, 0.7, s) * glm::smoothstep(0.45, 0.1, a)) * (1.0 - lobe);
     // Rim and groove are a few grid steps wide (the skin grid is about
     // 1.4 mm here): a 1.4 mm rim sampled on it saw-toothed along the ear.
-    h += helix * (0.2 * H * gauss(rim_d - 2.4, 2.2) - 0.18 * H * gauss(rim_d - 6.2, 2.4));
+    h += helix * (0.27 * H * gauss(rim_d - 2.4, 2.2) - 0.24 * H * gauss(rim_d - 6.2, 2.4));
     // Antihelix and its two crura, an inner ridge parallel to the rim.
     const double anti = ear_curve_distance(a, s, {{-0.55, -0.3}, {-0.1, -0.48}, {0.32, -0.42}, {0.68, 0.05}});
     const double crus = ear_curve_distance(a, s, {{0.32, -0.42}, {0.3, 0.35}});
-    h += 0.2 * H * gauss(std::min(anti, 1.1 * crus) * mm, 2.8);
+    h += 0.27 * H * gauss(std::min(anti, 1.1 * crus) * mm, 2.8);
     // Concha: a deep bowl in front of the antihelix, behind the tragus.
     const double cu = (a + 0.08) / 0.36, cv = (s - 0.2) / 0.42;
     const double bowl = std::max(0.0, 1.0 - cu * cu - cv * cv);
@@ -466,8 +466,19 @@ double FaceShape::hair_height(glm::dvec3 q) const {
     // seam). So the plain height, less a band, takes over with distance.
     constexpr double kBand = 12.0;
     const double far = raw - kBand;
-    const double k = 2.0;  // a smooth maximum: no crease where they meet
-    return 0.5 * (along_head + far + std::sqrt((along_head - far) * (along_head - far) + k * k));
+    const double k = 2.0;  // smooth maximum and minimum: no crease where they meet
+    const double height = 0.5 * (along_head + far + std::sqrt((along_head - far) * (along_head - far) + k * k));
+    // Below the sideburn's bottom the line's steepness misleads the other
+    // way: where it hands over to the front's (the band of sideburn_z) it
+    // is as steep at the lobe's height as at the sideburn's, and the skin
+    // down to the jaw read as a few mm from the hairline (a strip of fine
+    // hairs down the cheek). No hair grows below the line's lowest point,
+    // so a point below that is at least that far from it.
+    const double ear_back = p_.ear_centre_yz[1] - p_.ear_radii_yz[1] - 3.0;
+    const double lowest = mix(p_.hair_back_bottom_y, p_.sideburn_bottom_y, glm::smoothstep(ear_back - 35.0, ear_back, q.z)) -
+                          p_.hairline_wander;
+    const double below_lowest = q.y - lowest;
+    return 0.5 * (height + below_lowest - std::sqrt((height - below_lowest) * (height - below_lowest) + k * k));
 }
 
 FaceShape::HairFlow FaceShape::hair_flow(glm::dvec3 q) const {

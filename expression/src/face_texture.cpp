@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <vector>
 
+#include <glm/common.hpp>
 #include <glm/trigonometric.hpp>
 #include <glm/geometric.hpp>
 
@@ -36,11 +37,27 @@ struct Texel {
 // One brow hair: a stroke from its root along `dir` (unit, frontal x/y mm).
 // `side` is the unit normal of `dir` the hair curves towards, `bend` how far
 // its tip lies off the straight line (mm): the centre line is root +
-// t length dir + t^2 bend side, t 0 .. 1.
+// t length dir + t^2 bend side, t 0 .. 1. The forelock's strands are
+// strokes of the same kind.
 struct BrowHair {
     glm::dvec2 root, dir, side;
     double length, width, shade, bend;
 };
+
+// How much of the skin at p (frontal x/y mm) a hair stroke covers, and
+// where along it (*t: 0 root .. 1 tip). It tapers to the tip; its edge is
+// softened over about a texel so thin hairs stay continuous strokes in the
+// texture.
+double stroke_cover(const BrowHair& h, glm::dvec2 p, double* t) {
+    const glm::dvec2 rel = p - h.root;
+    const double along = glm::dot(rel, h.dir) / h.length;
+    if (along < -0.05 || along > 1.05) return 0.0;
+    const double across = std::abs(glm::dot(rel, h.side) - h.bend * along * along);
+    *t = std::clamp(along, 0.0, 1.0);
+    const double half = 0.5 * h.width * (1.0 - 0.55 * *t);
+    return (1.0 - glm::smoothstep(half, half + 0.22, across)) * glm::smoothstep(-0.05, 0.05, along) *
+           (1.0 - glm::smoothstep(0.92, 1.05, along));
+}
 
 class Painter {
 public:
@@ -64,6 +81,9 @@ private:
     // Hair cover 0 (skin) .. 1 and its colour; *roots: how much the roots'
     // grey shows under the skin (the scalp under thinning hair).
     double hair(glm::dvec3 q, Rgb* colour, double* roots) const;
+    // The forelock's stray strands at frontal (x, y): cover and colour.
+    double forelock(double x, double y, Rgb* colour) const;
+    void build_forelock();
 
     const FaceShape& s_;
     const FaceParams& p_;
@@ -73,6 +93,8 @@ private:
     glm::dvec2 grid_min_{0.0};
     int grid_w_ = 0, grid_h_ = 0;
     std::vector<std::vector<int>> grid_;
+    std::vector<BrowHair> locks_;
+    glm::dvec2 locks_min_{0.0}, locks_max_{0.0};  // their frontal box (mm)
 };
 
 Painter::BrowPlace Painter::brow_place(double x, double y) const {
@@ -204,6 +226,79 @@ Painter::Painter(const FaceShape& shape) : s_(shape), p_(shape.params()) {
             for (int gx = std::max(gx0, 0); gx <= std::min(gx1, grid_w_ - 1); ++gx)
                 grid_[static_cast<std::size_t>(gy) * grid_w_ + gx].push_back(k);
     }
+    build_forelock();
+}
+
+// Stray locks over the forehead: each from a root a few mm inside the front
+// hairline, falling along the strands' flow (so they sweep the same way as
+// the hair above them), its strands fanning out from the root.
+void Painter::build_forelock() {
+    const FaceParams::Forelock& fl = p_.hair_forelock;
+    if (fl.locks <= 0) return;
+    // The forehead's surface point at frontal (x, y).
+    auto surface = [&](double x, double y) {
+        const glm::dvec3 o{x, y, 0.0};
+        return o + glm::dvec3{0.0, 0.0, 1.0} * s_.cast(o, {0.0, 0.0, 1.0});
+    };
+    constexpr double kSpan = 30.0;  // mm either side of the midline, inside the temples' recession
+    locks_min_ = {1e9, 1e9};
+    locks_max_ = {-1e9, -1e9};
+    for (int k = 0; k < fl.locks; ++k) {
+        const double x = kSpan * (2.0 * (k + 0.5 + 0.7 * (hash(k, 1, 201) - 0.5)) / fl.locks - 1.0);
+        double y = p_.hairline_y;
+        for (int it = 0; it < 3; ++it) y = s_.hairline(surface(x, y));
+        y += 1.0 + 2.5 * hash(k, 2, 203);
+        // Along the flow: across it stays constant, and down the forehead.
+        constexpr double d = 1.0;
+        auto across = [&](double px, double py) { return s_.hair_flow(surface(px, py)).across; };
+        const glm::dvec2 g{across(x + d, y) - across(x - d, y), across(x, y + d) - across(x, y - d)};
+        glm::dvec2 dir = glm::length(g) > 1e-9 ? glm::normalize(glm::dvec2{-g.y, g.x}) : glm::dvec2{0.0, -1.0};
+        if (dir.y > 0.0) dir = -dir;
+        // Loose strands fall: steeper than the flow the combed hair keeps.
+        dir = glm::normalize(dir + glm::dvec2{0.0, -0.7});
+        const double lean = 0.5 * (hash(k, 3, 205) - 0.5);
+        dir = {dir.x * std::cos(lean) - dir.y * std::sin(lean), dir.x * std::sin(lean) + dir.y * std::cos(lean)};
+        const glm::dvec2 side{-dir.y, dir.x};
+        const double length = mix(fl.length[0], fl.length[1], hash(k, 4, 207));
+        const double curl = (hash(k, 5, 209) - 0.5) * 0.3 * length;  // the lock's own curve
+        for (int s = 0; s < fl.strands; ++s) {
+            const double o = s - 0.5 * (fl.strands - 1);
+            const double fan = 0.07 * o + 0.06 * (hash(k, s, 211) - 0.5);
+            BrowHair h;
+            h.root = glm::dvec2{x, y} + side * (0.3 * o);
+            h.dir = {dir.x * std::cos(fan) - dir.y * std::sin(fan), dir.x * std::sin(fan) + dir.y * std::cos(fan)};
+            h.side = {-h.dir.y, h.dir.x};
+            h.length = length * (0.7 + 0.3 * hash(k, s, 213));
+            h.bend = curl + 0.1 * length * (hash(k, s, 215) - 0.5);
+            h.width = fl.width * (0.8 + 0.4 * hash(k, s, 217));
+            h.shade = 0.85 + 0.4 * hash(k, s, 219);
+            locks_.push_back(h);
+            const glm::dvec2 tip = h.root + h.length * h.dir + h.bend * h.side;
+            locks_min_ = glm::min(locks_min_, glm::min(h.root, tip) - 2.0);
+            locks_max_ = glm::max(locks_max_, glm::max(h.root, tip) + 2.0);
+        }
+    }
+}
+
+double Painter::forelock(double x, double y, Rgb* colour) const {
+    if (x < locks_min_.x || y < locks_min_.y || x > locks_max_.x || y > locks_max_.y) return 0.0;
+    const Rgb hair = from255(p_.hair);
+    double clear = 1.0;
+    Rgb sum{};
+    double weight = 0.0;
+    for (const BrowHair& h : locks_) {
+        double along = 0.0;
+        const double cover = stroke_cover(h, {x, y}, &along);
+        if (cover <= 0.0) continue;
+        clear *= 1.0 - 0.8 * cover;
+        // Thinner and lit through towards the tip.
+        const double shade = h.shade * (1.0 + 0.3 * along);
+        sum = {sum.r + hair.r * shade * cover, sum.g + hair.g * shade * cover, sum.b + hair.b * shade * cover};
+        weight += cover;
+    }
+    if (weight <= 0.0) return 0.0;
+    *colour = sum * (1.0 / weight);
+    return 1.0 - clear;
 }
 
 double Painter::brow_hairs(double x, double y, Rgb* colour) const {
@@ -216,20 +311,13 @@ double Painter::brow_hairs(double x, double y, Rgb* colour) const {
     double weight = 0.0;
     for (int k : grid_[static_cast<std::size_t>(gy) * grid_w_ + gx]) {
         const BrowHair& h = hairs_[static_cast<std::size_t>(k)];
-        const glm::dvec2 rel = glm::dvec2{x, y} - h.root;
-        const double along = glm::dot(rel, h.dir) / h.length;
-        if (along < -0.05 || along > 1.05) continue;
-        const double across = std::abs(glm::dot(rel, h.side) - h.bend * along * along);
-        // Tapering to the tip; the edge softened over about a texel so thin
-        // hairs stay continuous strokes in the texture.
-        const double half = 0.5 * h.width * (1.0 - 0.55 * std::clamp(along, 0.0, 1.0));
-        const double cover = (1.0 - glm::smoothstep(half, half + 0.22, across)) *
-                             glm::smoothstep(-0.05, 0.05, along) * (1.0 - glm::smoothstep(0.92, 1.05, along));
+        double along = 0.0;
+        const double cover = stroke_cover(h, {x, y}, &along);
         if (cover <= 0.0) continue;
         // A single hair lets some skin through (it is thinner than a texel).
         clear *= 1.0 - 0.7 * cover;
         // Lighter towards the tip, where the hair is thinner.
-        const double shade = h.shade * (0.85 + 0.35 * std::clamp(along, 0.0, 1.0));
+        const double shade = h.shade * (0.85 + 0.35 * along);
         sum = {sum.r + brow.r * shade * cover, sum.g + brow.g * shade * cover, sum.b + brow.b * shade * cover};
         weight += cover;
     }
@@ -610,6 +698,13 @@ Texel Painter::skin(glm::dvec3 q) const {
     if (h > 0) {
         c = blend(c, hc, h);
         gloss = mix(gloss, 1.0, h);
+    }
+    if (q.z > 20.0) {
+        const double fl = forelock(q.x, q.y, &hc);
+        if (fl > 0) {
+            c = blend(c, hc, fl);
+            gloss = mix(gloss, 1.0, fl);
+        }
     }
     return {c, gloss};
 }
