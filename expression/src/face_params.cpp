@@ -332,6 +332,24 @@ FaceParams read_face_params(const std::string& params_dir) {
                 f.finish();
                 a.flush.push_back(fl);
             }
+            for (JsonReader& t : r.objects("tones")) {
+                FaceParams::Tone tone;
+                tone.centre = to_glm(t.numbers<2>("centre"));
+                tone.size = to_glm(t.numbers<2>("size"));
+                if (!(tone.size[0] > 0 && tone.size[1] > 0)) t.at("size").fail("two widths > 0 (mm)");
+                tone.tint = to_glm(t.numbers<3>("tint"));
+                for (int c = 0; c < 3; ++c)
+                    if (tone.tint[c] < 0.0 || tone.tint[c] > 1.5) t.at("tint").fail("three factors in [0, 1.5]");
+                tone.amount = t.number_in("amount", 0.0, 1.0);
+                t.finish();
+                a.tones.push_back(tone);
+            }
+            {
+                JsonReader b = r.object("blotches");
+                a.blotch_size = b.number_in("size_mm", 1.0, 50.0);
+                a.blotch_strength = b.number_in("strength", 0.0, 1.0);
+                b.finish();
+            }
             a.flush_breakup = r.number_in("flush_breakup", 0.0, 1.0);
             a.ear_flush = r.number_in("ear_flush", 0.0, 1.5);
             a.ear_fold_shade = r.number_in("ear_fold_shade", 0.0, 0.8);

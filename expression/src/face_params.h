@@ -234,9 +234,19 @@ struct FaceParams {
         glm::dvec2 centre{0.0}, size{0.0};  // |x|, y; Gaussian widths
         double amount = 0.0;
     };
+    // a regional cast: a Gaussian field (as Flush) that multiplies the
+    // colour by tint, amount 1 at its centre
+    struct Tone {
+        glm::dvec2 centre{0.0}, size{0.0};
+        glm::dvec3 tint{1.0};
+        double amount = 0.0;
+    };
     struct Albedo {
         double pigment_variation = 0.0, mottling = 0.0;
+        // mid-frequency blood blotches: their size (mm) and strength (redness)
+        double blotch_size = 1.0, blotch_strength = 0.0;
         std::vector<Flush> flush;
+        std::vector<Tone> tones;
         double flush_breakup = 0.0, ear_flush = 0.0, ear_fold_shade = 0.0;
         double freckle_spacing = 0.0, freckle_size = 0.0, freckle_strength = 0.0;
         // pore-scale grain: its size (mm) and +- strength

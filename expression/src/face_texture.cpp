@@ -452,6 +452,14 @@ double field(double x, double y, double cx, double cy, double sx, double sy) {
     return std::exp(-0.5 * (dx * dx + dy * dy));
 }
 Rgb tint(Rgb c, const glm::dvec3& t, double amount) { return blend(c, c * Rgb{t[0], t[1], t[2]}, amount); }
+// Redness at the luminance c had: the renderer bumps the base colour's
+// luminance relief (render/src/skin_maps.cpp), so blood variation finer than
+// a few mm must change the hue, not the value, or it turns into lumps.
+Rgb redden_hue(Rgb c, double amount) {
+    const Rgb r = redden(c, amount);
+    auto luma = [](Rgb x) { return 0.2126 * x.r + 0.7152 * x.g + 0.0722 * x.b; };
+    return r * (luma(c) / std::max(luma(r), 1e-6));
+}
 
 // Small round spots, one candidate per cell of a jittered grid of `spacing`
 // mm, present with `chance`, of radius 0.5 .. 1.5 times `size` mm and each
@@ -489,6 +497,16 @@ Texel Painter::skin(glm::dvec3 q) const {
     Rgb c = skin * (1.0 + al.pigment_variation * (pigment - 0.5) - 0.5 * half);
     const double blood = 0.55 * fbm(q.x * 0.21 + 11.0, q.y * 0.21, q.z * 0.21) + 0.45 * noise(q.x * 0.06, q.y * 0.06, q.z * 0.06 + 23.0);
     c = redden(c, al.mottling * (blood - 0.45));
+    // Blotches: blood pools unevenly a few mm across (the blotchiness of
+    // real skin seen close up), with soft irregular shapes (thresholded
+    // noise, not discs); a browner set apart (melanin) that darkens a little.
+    {
+        const glm::dvec3 b = q / al.blotch_size;
+        const double red = glm::smoothstep(0.5, 0.78, fbm(b.x + 3.1, b.y, b.z + 51.0));
+        const double brown = glm::smoothstep(0.55, 0.8, fbm(0.7 * b.x, 0.7 * b.y + 5.3, 0.7 * b.z + 57.0));
+        c = redden_hue(c, al.blotch_strength * red);
+        c = blend(c, c * Rgb{0.95, 0.92, 0.88}, al.blotch_strength * brown);
+    }
     // Pore-scale variation: follicles and the skin's microrelief darken
     // and lighten it at under a millimetre (the renderer's albedo relief
     // turns this into fine bumps too).
@@ -504,8 +522,14 @@ Texel Painter::skin(glm::dvec3 q) const {
     // corner, round the jaw to below the ear, fading on the neck; the
     // stubble's dots under the skin make it grainy at the fine scale.
     {
-        const double cheek_line = ax < 28.0 ? -46.0 : mix(-46.0, -14.0, std::min((ax - 28.0) / 34.0, 1.0));
-        const double beard = glm::smoothstep(3.0, -9.0, q.y - cheek_line + 4.0 * (noise(q.x * 0.15, q.y * 0.15, 31.0) - 0.5)) *
+        const double lateral = std::clamp((ax - 28.0) / 34.0, 0.0, 1.0);
+        const double cheek_line = mix(-46.0, -14.0, lateral);
+        // The moustache, chin and jaw carry the densest stubble; on the
+        // cheeks it thins upwards over a wider band (a sharp upper line read
+        // as a grey mask).
+        const double ramp = mix(9.0, 24.0, glm::smoothstep(0.0, 0.6, lateral));
+        const double below = cheek_line - q.y + 4.0 * (noise(q.x * 0.15, q.y * 0.15, 31.0) - 0.5);
+        const double beard = glm::smoothstep(-3.0, ramp, below) *
                              glm::smoothstep(-150.0, -118.0, q.y) * glm::smoothstep(p_.sideburn_z - 25.0, p_.sideburn_z - 5.0, q.z) *
                              (0.75 + 0.5 * noise(q.x * 1.7, q.y * 1.7, q.z * 1.7)) *
                              (ax > 55.0 ? 1.0 - std::min(1.0, s_.ear_relief(q.y, q.z)) : 1.0);  // not on the lobe
@@ -525,6 +549,25 @@ Texel Painter::skin(glm::dvec3 q) const {
         for (const auto& f : al.flush)
             flush += f.amount * field(f.centre[0] == 0.0 ? q.x : ax, q.y, f.centre[0], f.centre[1], f.size[0], f.size[1]);
         c = redden(c, flush * breakup * capillaries * (1.0 + 2.5 * half));
+        // Regional casts: the bridge yellower, violet under the eyes, the
+        // temples a little bluer (veins under thin skin); broken up like
+        // the flush so none reads as a painted shape.
+        for (const auto& t : al.tones) {
+            const double f = field(t.centre[0] == 0.0 ? q.x : ax, q.y, t.centre[0], t.centre[1], t.size[0], t.size[1]);
+            if (f > 1e-3) c = tint(c, t.tint, std::min(1.0, t.amount * f * breakup));
+        }
+        // Fine capillaries (telangiectasia) on the nose's wings and the
+        // cheeks beside them: short meandering red threads where a noise
+        // crosses its middle value, only in sparse patches; hue only, so
+        // they stay colour and not ridges.
+        {
+            const double where = field(ax, q.y, 16.0, -38.0, 9.0, 7.0) + 0.6 * field(ax, q.y, 30.0, -30.0, 12.0, 9.0);
+            if (where > 0.02) {
+                const double thread = 1.0 - glm::smoothstep(0.0, 0.035, std::abs(noise(q.x * 0.7, q.y * 0.7, q.z * 0.7 + 61.0) - 0.5));
+                const double patch = glm::smoothstep(0.55, 0.8, noise(q.x * 0.2, q.y * 0.2, 63.0));
+                c = redden_hue(c, 0.9 * thread * patch * std::min(where, 1.0));
+            }
+        }
         // Freckles: one candidate per cell of a jittered grid, over the nose
         // and cheeks mostly.
         {
