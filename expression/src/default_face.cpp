@@ -677,6 +677,14 @@ void Generator::build_mouth_interior(Face& face) {
             u = detail::tile_u0(Tile::Teeth) + detail::kTile * (0.02 + 0.96 * k);
             v = detail::kTile * ((upper ? 0.5 : 0.0) + 0.02 + 0.46 * c / 3.0);
         };
+        // The biting edges are not one straight line: the lateral incisors'
+        // stop short of the centrals', the canine's tip reaches nearly as
+        // far, the back teeth rise along the curve of the occlusal plane (mm
+        // towards the root); a level edge read as a flat strip of teeth.
+        auto tip_y = [&](std::size_t t) {
+            constexpr double kEdgeRise[] = {0.0, 0.7, 0.25, 0.6, 0.9, 1.2};
+            return y_edge + sign * (upper ? 1.0 : 0.5) * kEdgeRise[std::min<std::size_t>(t, 5)];
+        };
         std::vector<double> bounds{0.0};  // tooth boundaries along the arch (mm from the midline)
         for (const glm::dvec2& c : crowns) bounds.push_back(bounds.back() + c[0]);
         int first = -1;
@@ -690,7 +698,11 @@ void Generator::build_mouth_interior(Face& face) {
                 frame(s_mid, side, pos, along, out);
                 // Cross-section half sizes along the arch (a) and across it (b) at f = 0 (gum) .. 1 (edge).
                 auto half_a = [&](double f) {
-                    const double w = 0.5 * width - 0.08;  // the crowns touch at their contact points
+                    // The crowns press into their neighbours a little, so
+                    // only the embrasures by the edge and the gum show the
+                    // dark mouth behind: apart, a black seam ran the full
+                    // height of every gap (a grille).
+                    const double w = 0.5 * width + 0.12;
                     if (canine) return w * (f < 0.6 ? detail::mix(0.8, 1.0, f / 0.6) : detail::mix(1.0, 0.25, (f - 0.6) / 0.4));
                     if (incisor) return w * (f < 0.7 ? detail::mix(0.78, 1.0, f / 0.7) : 1.0);
                     return w * detail::mix(0.85, 0.95, f);
@@ -704,10 +716,11 @@ void Generator::build_mouth_interior(Face& face) {
                 const double lean = incisor ? 2.0 : (canine ? 1.0 : 0.0);
                 const int tooth_first = face.vertex_count();
                 if (first < 0) first = tooth_first;
+                const double y_tip = tip_y(t);
                 double u, v;
                 for (int l = 0; l < kLevels; ++l) {
                     const double f = static_cast<double>(l) / (kLevels - 1);
-                    const double y = y_edge + sign * height * (1.0 - f) + (upper ? 0.0 : 0.0);
+                    const double y = y_tip + sign * height * (1.0 - f);
                     const glm::dvec3 c = pos + out * (lean * f - 0.5 * half_b(0.0)) + glm::dvec3{0, y, 0};
                     for (int k = 0; k < kRound; ++k) {
                         const double ang = 2 * kPi * k / kRound;
@@ -717,12 +730,12 @@ void Generator::build_mouth_interior(Face& face) {
                         const double px = half_a(f) * (ca < 0 ? -1 : 1) * std::pow(std::abs(ca), ex);
                         const double pz = half_b(f) * (sa < 0 ? -1 : 1) * std::pow(std::abs(sa), ex);
                         // Labial side (pz > 0) maps to c 0..1, lingual to 3..2.
-                        tile_uv(std::pow(std::abs(ca), 4.0), sa >= 0 ? 0.35 + 0.6 * f : 2.65 - 0.6 * f, u, v);
+                        tile_uv(ca * ca, sa >= 0 ? 0.35 + 0.6 * f : 2.65 - 0.6 * f, u, v);
                         add_vertex(face, c + along * px + out * pz, u, v, part);
                     }
                 }
                 tile_uv(0.0, 1.0, u, v);
-                const glm::dvec3 tip = pos + out * (lean - 0.5 * half_b(0.0)) + glm::dvec3{0, y_edge - sign * 0.3, 0};
+                const glm::dvec3 tip = pos + out * (lean - 0.5 * half_b(0.0)) + glm::dvec3{0, y_tip - sign * 0.3, 0};
                 const int cap = add_vertex(face, tip, u, v, part).idx();
                 auto ring = [&](int l, int k) { return tooth_first + l * kRound + (k % kRound); };
                 // Out of the tooth: from its section's centre (the sections
@@ -763,7 +776,7 @@ void Generator::build_mouth_interior(Face& face) {
             if (std::abs(sarc) < 1e-6) d = 0.0;
             std::size_t t = 0;
             while (t + 1 < crowns.size() && std::abs(sarc) > bounds[t + 1]) ++t;
-            const double neck = y_edge + sign * crowns[t][1];
+            const double neck = tip_y(t) + sign * crowns[t][1];
             const double papilla = 2.2 * std::exp(-(d / 1.3) * (d / 1.3));
             const double thick = (t < 2 ? 3.2 : (t == 2 ? 3.8 : 4.2)) + 0.7;
             const glm::dvec3 mid = pos + out * (-0.5 * (t < 2 ? 3.2 : 3.8));

@@ -603,6 +603,20 @@ Texel Painter::skin(glm::dvec3 q) const {
         // lower lip's centre (it faces the light and is fuller), fading
         // towards the skin's tone at the corners, with fine vertical lines.
         const double hw = s_.mouth_half_width();
+        // The commissures: a small pocket where the lips' crease ends, in
+        // the modiolus' shade, darker and a little redder (the mucosa shows
+        // where the lips fold in). The face turns away there (z about 50),
+        // so this is outside the vermilion's front-facing test below.
+        if (q.z > 30.0) {
+            const double corner_y = s_.mouth_line(hw);
+            const double pocket = field(ax, q.y, hw + 0.8, corner_y - 0.3, 2.4, 1.5);
+            // and its fold runs on a few mm past the corner, down and out.
+            const double past = ax - hw;
+            const double fold = past > 0.0 && past < 4.0
+                                    ? (1.0 - past / 4.0) * std::exp(-std::pow((q.y - corner_y + 0.35 * past) / 0.6, 2))
+                                    : 0.0;
+            c = blend(c, c * Rgb{0.52, 0.4, 0.4}, std::min(0.8 * pocket + 0.5 * fold, 0.85));
+        }
         if (ax < hw + 4.0 && q.z > 60.0) {
             const double up = s_.upper_border(q.x), lo = s_.lower_border(q.x);
             const double wander = 0.35 * (noise(q.x * 0.6, q.y * 0.6, 3.0) - 0.5);
@@ -612,7 +626,7 @@ Texel Painter::skin(glm::dvec3 q) const {
             const double line_y = s_.mouth_line(q.x);
             const bool upper = q.y > line_y;
             const double roll = (1.0 - glm::smoothstep(0.0, 1.2, std::abs(inside + 0.6 * border))) * (upper ? 1.0 : 0.4);
-            c = blend(c, c * 1.06, 0.5 * roll * (1.0 - m));
+            c = blend(c, c * 1.03, 0.5 * roll * (1.0 - m));
             if (m > 0) {
                 const double to_line = std::abs(q.y - line_y);
                 const double crease = glm::smoothstep(0.0, 2.5, to_line);
@@ -629,6 +643,10 @@ Texel Painter::skin(glm::dvec3 q) const {
                 Rgb lips = from255(p_.lips) * (0.78 + 0.22 * crease) * (upper ? 0.93 : 1.0) * (1.0 + 0.1 * fullness) *
                            (0.94 + 0.12 * noise(q.x * 1.3, q.y * 0.9, 1.0));
                 lips = blend(lips, c * Rgb{0.95, 0.9, 0.9}, 0.45 * glm::smoothstep(0.55 * hw, hw, ax));
+                // Just inside the border the vermilion is thinner-coloured,
+                // nearer the skin's tone: the red deepens over a few mm
+                // instead of stepping up at the border (an outline).
+                lips = blend(lips, c * Rgb{0.97, 0.9, 0.88}, 0.35 * (1.0 - glm::smoothstep(0.0, 1.5 * border, inside)));
                 // Grooves darker, the ridges between them a shade lighter:
                 // the relief map raises the ridges, breaking the sheen.
                 lips = lips * (1.0 + al.lip_lines * mid * (0.06 - 0.4 * groove));
@@ -779,7 +797,9 @@ Rgb Painter::tile(double u, double v) const {
             // Each crown darker towards its contacts (its sides turn away
             // and the gaps between crowns are in shadow), softly: a black
             // seam round every crown read as a grille.
-            Rgb teeth = from255(p_.teeth) * (1.0 - 0.3 * (1.0 - glm::smoothstep(0.1, 1.2, gap)));
+            // The shade grows over the crown's whole half-width, so the
+            // labial face reads rounded, brightest down its middle.
+            Rgb teeth = from255(p_.teeth) * (1.0 - 0.42 * (1.0 - glm::smoothstep(0.1, 2.8, gap)));
             // Enamel is thin at the neck, where the yellower dentin shows,
             // and translucent at the biting edge, grey-blue against the dark
             // mouth behind it.
