@@ -411,6 +411,28 @@ FaceParams read_face_params(const std::string& params_dir) {
             }
             r.finish();
         }
+        {
+            JsonReader r = top.object("shirt");
+            auto& s = p.shirt;
+            s.colour = colour(r, "colour");
+            JsonReader n = r.object("neckline_y");
+            s.neckline_front = n.number_in("front", -300.0, -100.0);
+            s.neckline_side = n.number_in("side", -300.0, -100.0);
+            s.neckline_back = n.number_in("back", -300.0, -100.0);
+            n.finish();
+            s.dip_half_angle_deg = r.number_in("dip_half_angle_deg", 5.0, 90.0);
+            s.collar_mm = r.number_in("collar_mm", 0.0, 40.0);
+            s.collar_shade = r.number_in("collar_shade", 0.7, 1.3);
+            s.rib_mm = r.number_in("rib_mm", 0.5, 10.0);
+            s.rib_contrast = r.number_in("rib_contrast", 0.0, 0.2);
+            s.seam_shade = r.number_in("seam_shade", 0.0, 0.5);
+            s.folds = r.number_in("folds", 0.0, 0.3);
+            s.fold_count = r.number_in("fold_count", 0.0, 20.0);
+            s.mottling = r.number_in("mottling", 0.0, 0.2);
+            s.neck_shade_mm = r.number_in("neck_shade_mm", 0.0, 20.0);
+            s.neck_shade = r.number_in("neck_shade", 0.0, 0.8);
+            r.finish();
+        }
     });
     return p;
 }

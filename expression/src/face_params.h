@@ -274,6 +274,19 @@ struct FaceParams {
     struct Gloss {
         double t_zone = 1.0, lips = 1.0, lid_margin = 1.0, tear_line = 1.0;
     } gloss;
+    // the T-shirt painted over the shoulders and chest (face.json "shirt"):
+    // its neckline's height (mm) in front, at the neck's sides and at the
+    // back, how far round the neck (degrees of azimuth about the neck's
+    // axis) the front's dip reaches, the crew collar's band and the shade
+    // it casts on the neck
+    struct Shirt {
+        glm::dvec3 colour{0.0};  // sRGB 0..255
+        double neckline_front = 0.0, neckline_side = 0.0, neckline_back = 0.0;
+        double dip_half_angle_deg = 1.0;
+        double collar_mm = 0.0, collar_shade = 1.0, rib_mm = 1.0, rib_contrast = 0.0, seam_shade = 0.0;
+        double folds = 0.0, fold_count = 0.0, mottling = 0.0;
+        double neck_shade_mm = 0.0, neck_shade = 0.0;
+    } shirt;
 };
 
 FaceParams read_face_params(const std::string& params_dir);

@@ -83,6 +83,10 @@ private:
     double hair(glm::dvec3 q, Rgb* colour, double* roots) const;
     // The forelock's stray strands at frontal (x, y): cover and colour.
     double forelock(double x, double y, Rgb* colour) const;
+    // The T-shirt over the shoulders and chest: the colour at q given the
+    // skin's colour c there (cloth below the neckline, the collar's shade
+    // on the neck above it); *gloss becomes cloth's where it covers.
+    Rgb shirt(glm::dvec3 q, Rgb c, double* gloss) const;
     void build_forelock();
 
     const FaceShape& s_;
@@ -767,7 +771,64 @@ Texel Painter::skin(glm::dvec3 q) const {
             gloss = mix(gloss, 1.0, fl);
         }
     }
+    c = shirt(q, c, &gloss);
     return {c, gloss};
+}
+
+Rgb Painter::shirt(glm::dvec3 q, Rgb c, double* gloss) const {
+    const FaceParams::Shirt& sh = p_.shirt;
+    if (q.y > std::max({sh.neckline_front, sh.neckline_side, sh.neckline_back}) + sh.neck_shade_mm + 2.0) return c;
+    // Azimuth about the neck's leaning axis (0 in front, pi at the back),
+    // on the neck's elliptic section so it is even round the neck.
+    const double lean = std::tan(glm::radians(p_.neck_lean_deg));
+    const double axis_z = p_.neck_centre_z + (q.y - p_.neck_top_y) * lean;
+    const double dz = q.z - axis_z;
+    const double ax = std::abs(q.x);
+    const double dip = glm::radians(sh.dip_half_angle_deg);
+    // The neckline's height at azimuth a: a flat-bottomed dip in front
+    // rising to the sides, then on up behind them at once (over the
+    // trapezius' slope, which stands above the side's height just behind
+    // the neck: a slower rise left a rim of skin on the shoulders' outline).
+    auto neckline = [&](double a) {
+        if (a < 0.5 * kPi)
+            return mix(sh.neckline_front, sh.neckline_side, glm::smoothstep(0.0, dip, a));
+        return mix(sh.neckline_side, sh.neckline_back, std::sin(a - 0.5 * kPi));
+    };
+    const double a = std::atan2(ax / p_.neck_radii[0], dz / p_.neck_radii[1]);
+    const double r = std::max(std::hypot(ax, dz), 30.0);  // mm per radian along the neck's surface
+    constexpr double kDa = 0.01;
+    const double slope = (neckline(std::min(a + kDa, kPi)) - neckline(std::max(a - kDa, 0.0))) / (2.0 * kDa * r);
+    // Distance below the neckline across the curve (mm; < 0 on the neck).
+    const double below = (neckline(a) - q.y) / std::sqrt(1.0 + slope * slope);
+    if (below < 0.0) {
+        const double shade = sh.neck_shade * (1.0 - glm::smoothstep(0.0, sh.neck_shade_mm, -below));
+        return c * (1.0 - shade);
+    }
+    // Cloth: broad mottling and a few soft folds fanning from the neck's
+    // base out to the shoulders, wandering; nothing fine.
+    Rgb cloth = from255(sh.colour);
+    const double broad = fbm(q.x * 0.02, q.y * 0.02, q.z * 0.02 + 91.0) - 0.5;
+    const double fan = std::atan2(sh.neckline_side + 20.0 - q.y, ax + 1.0);  // 0 across to the shoulder .. pi/2 down the chest
+    const double wander = 1.2 * (noise(q.x * 0.015, q.y * 0.015, 93.0) - 0.5);
+    const double fold = std::sin(sh.fold_count * 2.0 * fan + wander + (q.x < 0 ? 0.7 : 0.0));
+    const double fold_reach = glm::smoothstep(0.0, 12.0, below) * (1.0 - 0.6 * glm::smoothstep(40.0, 120.0, below));
+    cloth = cloth * (1.0 + 2.0 * sh.mottling * broad + sh.folds * fold * fold_reach);
+    // The collar: a ribbed band below the neckline, its ribs across it, a
+    // thin shadow along the seam under it.
+    if (below < sh.collar_mm + 2.0) {
+        const double band = 1.0 - glm::smoothstep(sh.collar_mm - 0.5, sh.collar_mm + 0.5, below);
+        const double rib = std::cos(2.0 * kPi * r * a / sh.rib_mm);
+        Rgb collar = from255(sh.colour) * (sh.collar_shade * (1.0 + 2.0 * sh.mottling * broad) + sh.rib_contrast * rib);
+        cloth = blend(cloth, collar, band);
+        const double seam = std::exp(-std::pow((below - sh.collar_mm) / 0.8, 2));
+        cloth = cloth * (1.0 - sh.seam_shade * seam);
+    }
+    // Softened over 2 mm: the rows below the neck are 6 mm apart and get
+    // few texels (v is linear in the row), so a sharper edge renders as a
+    // staircase.
+    const double cover = glm::smoothstep(0.0, 2.0, below);
+    *gloss = mix(*gloss, 1.0, cover);
+    return blend(c * (1.0 - sh.neck_shade), cloth, cover);
 }
 
 Rgb Painter::tile(double u, double v) const {

@@ -307,5 +307,37 @@ TEST(FaceTexture, AlphaHoldsTheRegionsRoughness) {
     EXPECT_LT(nose, cheek - 0.05);
 }
 
+// The bust is dressed (face.json shirt): the shoulders are dark cloth, dark
+// enough that the renderer lights it as it lights hair (below skin.json's
+// hair mean_luminance[0], linear 0.06), with no fine noise; the neck above
+// the collar is skin, shaded just above the collar's edge.
+TEST(FaceTexture, ShirtCoversTheShouldersAndTheNeckEndsAtItsCollar) {
+    const Face& f = painted_face();
+    auto linear = [](double c) { return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); };
+    std::vector<double> cloth;
+    for (int v = 0; v < f.vertex_count(); ++v) {
+        if (f.parts[v] != VertexPart::Skin) continue;
+        const auto p = f.mesh.point(TriMesh::VertexHandle(v));
+        if (p[1] > -165.0 || std::abs(p[0]) < 80.0) continue;  // the shoulders, beside the neck
+        const Texel t = texel_of(v);
+        cloth.push_back(0.2126 * linear(t.r) + 0.7152 * linear(t.g) + 0.0722 * linear(t.b));
+        EXPECT_GE(t.b, t.r) << "a navy-charcoal cloth, not skin, at vertex " << v;
+    }
+    ASSERT_GT(cloth.size(), 50u);
+    double mean = 0.0;
+    for (double c : cloth) mean += c;
+    mean /= static_cast<double>(cloth.size());
+    EXPECT_LT(*std::max_element(cloth.begin(), cloth.end()), 0.06) << "darker than the hair mask's threshold";
+    EXPECT_GT(mean, 0.02) << "cloth, not a black void";
+    for (double c : cloth) EXPECT_NEAR(c, mean, 0.35 * mean) << "low-contrast folds, no noise";
+    // Down the neck's front: skin well above the neckline (y -176 in
+    // front), then cloth from the collar on, with no skin showing again.
+    const std::vector<double> down = luminance_between(0.0, -150.0, -190.0, 80);
+    EXPECT_GT(down.front(), 0.45);
+    const auto first_cloth = std::find_if(down.begin(), down.end(), [](double l) { return l < 0.3; });
+    ASSERT_NE(first_cloth, down.end()) << "no collar down the neck's front";
+    for (auto it = first_cloth; it != down.end(); ++it) EXPECT_LT(*it, 0.3);
+}
+
 }  // namespace
 }  // namespace emoface::expression
