@@ -644,7 +644,7 @@ Texel Painter::skin(glm::dvec3 q) const {
                                       (0.5 + noise(q.x * 0.8, q.y * 0.4, 2.0));
                 const double mid = glm::smoothstep(0.2, 1.5, inside) * (0.3 + 0.7 * crease);
                 const double fullness = field(q.x, q.y, 0.0, mix(line_y, lo, 0.45), 9.0, 2.6);
-                Rgb lips = from255(p_.lips) * (0.78 + 0.22 * crease) * (upper ? 0.93 : 1.0) * (1.0 + 0.1 * fullness) *
+                Rgb lips = from255(p_.lips) * (0.78 + 0.22 * crease) * (upper ? 0.93 : 1.0) * (1.0 + 0.2 * fullness) *
                            (0.94 + 0.12 * noise(q.x * 1.3, q.y * 0.9, 1.0));
                 lips = blend(lips, c * Rgb{0.95, 0.9, 0.9}, 0.45 * glm::smoothstep(0.55 * hw, hw, ax));
                 // Just inside the border the vermilion is thinner-coloured,
@@ -844,7 +844,9 @@ Rgb Painter::tile(double u, double v) const {
             return {c[0], c[1], c[2]};
         }
         case Tile::Cavity:
-            return from255(p_.mouth) * (0.3 + 0.7 * std::min(r, 1.0));
+            // Lit only through the lips' opening (face_occlusion.cpp), so its
+            // albedo stays a mid red to the back: 0.3 there rendered black.
+            return from255(p_.mouth) * (0.6 + 0.4 * std::min(r, 1.0));
         case Tile::Teeth: {
             const bool upper = lv >= 0.5;
             const double c = ((upper ? lv - 0.5 : lv) - 0.02) / 0.46 * 3.0;  // 0 root, 1 edge (front), 3 root (back)
@@ -861,12 +863,18 @@ Rgb Painter::tile(double u, double v) const {
             // The shade grows over the crown's whole half-width, so the
             // labial face reads rounded, brightest down its middle.
             Rgb teeth = from255(p_.teeth) * (1.0 - 0.42 * (1.0 - glm::smoothstep(0.1, 2.8, gap)));
-            // Enamel is thin at the neck, where the yellower dentin shows,
-            // and translucent at the biting edge, grey-blue against the dark
-            // mouth behind it.
+            // Each crown its own shade, and the arch darker from the
+            // incisors back (it turns away from the light into the mouth's
+            // shade): one even white read as a bright strip of plastic.
+            const double crown = std::floor((k - 0.5) * 14.0);
+            teeth = teeth * (0.93 + 0.1 * hash(static_cast<int>(crown), upper ? 1 : 2, 211)) *
+                    (1.0 - 0.3 * glm::smoothstep(6.0, 28.0, s));
+            // Enamel is thin at the neck, where the yellower, darker dentin
+            // shows, and translucent at the biting edge, grey-blue against
+            // the dark mouth behind it.
             const double front = c <= 1.5 ? c : 3.0 - c;  // 0 gum .. 1 edge, either face
-            teeth = blend(teeth * Rgb{0.9, 0.84, 0.72}, teeth, glm::smoothstep(0.3, 0.65, front));
-            teeth = blend(teeth, teeth * Rgb{0.78, 0.82, 0.9}, glm::smoothstep(0.8, 1.0, front));
+            teeth = blend(teeth * Rgb{0.82, 0.74, 0.6}, teeth, glm::smoothstep(0.3, 0.7, front));
+            teeth = blend(teeth, teeth * Rgb{0.72, 0.74, 0.8}, glm::smoothstep(0.78, 1.0, front));
             // The gum: pink, a darker red along its margin on the crown.
             const double gum = 1.0 - glm::smoothstep(0.22, 0.3, front);
             const Rgb gums{0.74, 0.4, 0.4};
