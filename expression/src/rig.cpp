@@ -531,9 +531,13 @@ void FaceRig::build_cheek_masses(detail::GeodesicGraph& graph, double es) {
         cheek_mass_.push_back({fap::feature_point_index(corner_id), out});
         const double radius = kMassRadius * es;
         // Straight-line distance: the graph's edge-path distance zigzags at
-        // the mass's scale and creased its top.
+        // the mass's scale and creased its top. The search runs kMassSearch
+        // times further along the edges, so no vertex the straight-line bell
+        // still weights is left out (cut off at the path radius, the bell
+        // stepped: a dent from the outer eye corner down the cheek in joy).
+        constexpr double kMassSearch = 2.0;
         const V middle = to_v(neutral_[source]);
-        for (auto [v, path] : graph.within({source}, radius)) {
+        for (auto [v, path] : graph.within({source}, kMassSearch * radius)) {
             if (parts_[v] != VertexPart::Skin) continue;
             const double g = glm::length(to_v(neutral_[v]) - middle);
             const double s = beside_fold({neutral_[v][0], neutral_[v][1]});
