@@ -663,16 +663,20 @@ void Generator::build_mouth_interior(Face& face) {
             out = detail::normalised(glm::dvec3{along.z, 0.0, -along.x});  // horizontal, away from the arch's inside
             if (glm::dot(out, glm::dvec3{pos.x, 0.0, pos.z - (z0 - D)}) < 0) out = -out;
         };
-        auto tile_uv = [&](double toward_contact, double c, double& u, double& v) {
+        auto tile_uv = [&](std::size_t crown, double toward_contact, double c, double& u, double& v) {
             // The painter's teeth tile (face_texture.cpp): c 0 gum .. 1 edge
             // (front) .. 2 edge (back) .. 3 gum; k along the arch, where it
             // paints the shaded gaps of a one-piece arch. The crowns are apart
-            // here, so all take the columns just past one gap (31.4 mm along
-            // the upper arch, 0.8 of that along the lower), a crown's sides
+            // here, so each takes the columns just past its own distal gap
+            // (the tile ends before the molar's, 41 mm: it shares the second
+            // premolar's; 0.8 of that along the lower arch), a crown's sides
             // (toward_contact 1) nearest it: each crown is shaded towards its
             // contacts with its neighbours, and a row of them reads as teeth,
-            // not a white strip.
-            const double s = (upper ? 31.4 : 0.8 * 31.4) + 0.1 + 2.9 * (1.0 - toward_contact);
+            // not a white strip; and the painter darkens the arch from the
+            // incisors back and gives each column its own shade.
+            constexpr double kDistalGap[] = {4.3, 10.6, 17.8, 24.6, 31.4};
+            const double gap = kDistalGap[std::min<std::size_t>(crown, 4)];
+            const double s = (upper ? gap : 0.8 * gap) + 0.1 + 2.9 * (1.0 - toward_contact);
             const double k = 0.5 + s / p_.teeth_half_width / (0.92 * kPi);
             u = detail::tile_u0(Tile::Teeth) + detail::kTile * (0.02 + 0.96 * k);
             v = detail::kTile * ((upper ? 0.5 : 0.0) + 0.02 + 0.46 * c / 3.0);
@@ -730,11 +734,11 @@ void Generator::build_mouth_interior(Face& face) {
                         const double px = half_a(f) * (ca < 0 ? -1 : 1) * std::pow(std::abs(ca), ex);
                         const double pz = half_b(f) * (sa < 0 ? -1 : 1) * std::pow(std::abs(sa), ex);
                         // Labial side (pz > 0) maps to c 0..1, lingual to 3..2.
-                        tile_uv(ca * ca, sa >= 0 ? 0.35 + 0.6 * f : 2.65 - 0.6 * f, u, v);
+                        tile_uv(t, ca * ca, sa >= 0 ? 0.35 + 0.6 * f : 2.65 - 0.6 * f, u, v);
                         add_vertex(face, c + along * px + out * pz, u, v, part);
                     }
                 }
-                tile_uv(0.0, 1.0, u, v);
+                tile_uv(t, 0.0, 1.0, u, v);
                 const glm::dvec3 tip = pos + out * (lean - 0.5 * half_b(0.0)) + glm::dvec3{0, y_tip - sign * 0.3, 0};
                 const int cap = add_vertex(face, tip, u, v, part).idx();
                 auto ring = [&](int l, int k) { return tooth_first + l * kRound + (k % kRound); };
@@ -787,7 +791,7 @@ void Generator::build_mouth_interior(Face& face) {
             const double cs[4] = {0.05, 0.0, 3.0, 2.95};
             for (int c = 0; c < 4; ++c) {
                 double u, v;
-                tile_uv(0.0, cs[c], u, v);
+                tile_uv(4, 0.0, cs[c], u, v);
                 add_vertex(face, sec[c], u, v, part);
             }
         }

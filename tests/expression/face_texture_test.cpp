@@ -339,5 +339,45 @@ TEST(FaceTexture, ShirtCoversTheShouldersAndTheNeckEndsAtItsCollar) {
     for (auto it = first_cloth; it != down.end(); ++it) EXPECT_LT(*it, 0.3);
 }
 
+// The mouth's inside (face_texture.cpp Painter::tile): the teeth are not one
+// even white strip (observers: 'a bright uniform white strip') but ivory,
+// darker from the incisors back along the arch, and the cavity's back is a
+// mid red, not black (the occlusion bake darkens it further; at a third of
+// face.json colours.mouth it rendered as a void).
+TEST(FaceTexture, TeethDarkenAlongTheArchAndTheCavityIsRed) {
+    const double kTile = 0.25;
+    // The upper arch's labial faces, mid-crown (0.4..0.75 of the way from
+    // the gum to the edge), at the vertices' own UVs (the tile is painted
+    // only under its triangles; default_face.cpp gives each crown the
+    // columns past its distal gap): the central incisors' (4.3..7.3 mm along
+    // the arch) against the back teeth's (past 30 mm).
+    const Face& f = painted_face();
+    Texel incisor{0, 0, 0, 0}, molar{0, 0, 0, 0};
+    int n_incisor = 0, n_molar = 0;
+    for (int v = 0; v < f.vertex_count(); ++v) {
+        const auto t = f.mesh.texcoord2D(TriMesh::VertexHandle(v));
+        const double lu = t[0] / kTile - 2.0, lv = t[1] / kTile;
+        if (lu < 0.0 || lu >= 1.0 || lv < 0.5 || lv > 1.0) continue;
+        const double front = ((lv - 0.5) - 0.02) / 0.46 * 3.0;  // 0 gum .. 1 edge
+        if (front < 0.4 || front > 0.75) continue;
+        const double s = std::abs(27.0 * ((lu - 0.02) / 0.96 - 0.5) * 3.14159265 * 0.92);
+        Texel* sum = s < 8.0 ? &incisor : s > 30.0 ? &molar : nullptr;
+        if (!sum) continue;
+        const Texel c = texel_at(t[0], t[1]);
+        sum->r += c.r, sum->g += c.g, sum->b += c.b;
+        ++(s < 8.0 ? n_incisor : n_molar);
+    }
+    ASSERT_GT(n_incisor, 0);
+    ASSERT_GT(n_molar, 0);
+    incisor = {incisor.r / n_incisor, incisor.g / n_incisor, incisor.b / n_incisor, 1};
+    molar = {molar.r / n_molar, molar.g / n_molar, molar.b / n_molar, 1};
+    EXPECT_LT(incisor.luminance(), 0.75) << "near-white, not ivory";
+    EXPECT_LT(incisor.b, incisor.r - 0.08) << "ivory is warm";
+    EXPECT_LT(molar.luminance(), 0.88 * incisor.luminance()) << molar.luminance() << " vs " << incisor.luminance();
+    const Texel back = texel_at(1.5 * kTile, 0.5 * kTile);
+    EXPECT_GT(back.r, 0.3) << back.r;
+    EXPECT_GT(back.r, 2.0 * back.g) << back.r << " vs " << back.g;
+}
+
 }  // namespace
 }  // namespace emoface::expression
