@@ -59,6 +59,28 @@ double stroke_cover(const BrowHair& h, glm::dvec2 p, double* t) {
            (1.0 - glm::smoothstep(0.92, 1.05, along));
 }
 
+// Hair strokes laid over one texel, one at a time: each covers part of the
+// skin and lets some through (a hair is thinner than a texel), and tints
+// what it covers with its shade of the hair's tone.
+struct StrokeMix {
+    double clear = 1.0;  // the share of skin no stroke covers
+    Rgb sum{};
+    double weight = 0.0;
+
+    void add(const Rgb& tone, double cover, double opacity, double shade) {
+        clear *= 1.0 - opacity * cover;
+        sum = {sum.r + tone.r * shade * cover, sum.g + tone.g * shade * cover, sum.b + tone.b * shade * cover};
+        weight += cover;
+    }
+    // How much of the texel hair covers (0: none, *colour untouched) and
+    // the covering hairs' mean colour.
+    double result(Rgb* colour) const {
+        if (weight <= 0.0) return 0.0;
+        *colour = sum * (1.0 / weight);
+        return 1.0 - clear;
+    }
+};
+
 class Painter {
 public:
     explicit Painter(const FaceShape& shape);
@@ -287,22 +309,14 @@ void Painter::build_forelock() {
 double Painter::forelock(double x, double y, Rgb* colour) const {
     if (x < locks_min_.x || y < locks_min_.y || x > locks_max_.x || y > locks_max_.y) return 0.0;
     const Rgb hair = from255(p_.hair);
-    double clear = 1.0;
-    Rgb sum{};
-    double weight = 0.0;
+    StrokeMix mix;
     for (const BrowHair& h : locks_) {
         double along = 0.0;
         const double cover = stroke_cover(h, {x, y}, &along);
-        if (cover <= 0.0) continue;
-        clear *= 1.0 - 0.8 * cover;
         // Thinner and lit through towards the tip.
-        const double shade = h.shade * (1.0 + 0.3 * along);
-        sum = {sum.r + hair.r * shade * cover, sum.g + hair.g * shade * cover, sum.b + hair.b * shade * cover};
-        weight += cover;
+        if (cover > 0.0) mix.add(hair, cover, 0.8, h.shade * (1.0 + 0.3 * along));
     }
-    if (weight <= 0.0) return 0.0;
-    *colour = sum * (1.0 / weight);
-    return 1.0 - clear;
+    return mix.result(colour);
 }
 
 double Painter::brow_hairs(double x, double y, Rgb* colour) const {
@@ -310,24 +324,15 @@ double Painter::brow_hairs(double x, double y, Rgb* colour) const {
     const int gy = static_cast<int>(std::floor((y - grid_min_[1]) / kBucket));
     if (gx < 0 || gy < 0 || gx >= grid_w_ || gy >= grid_h_) return 0.0;
     const Rgb brow = from255(p_.brows);
-    double clear = 1.0;  // the share of skin no hair covers
-    Rgb sum{};
-    double weight = 0.0;
+    StrokeMix mix;
     for (int k : grid_[static_cast<std::size_t>(gy) * grid_w_ + gx]) {
         const BrowHair& h = hairs_[static_cast<std::size_t>(k)];
         double along = 0.0;
         const double cover = stroke_cover(h, {x, y}, &along);
-        if (cover <= 0.0) continue;
-        // A single hair lets some skin through (it is thinner than a texel).
-        clear *= 1.0 - 0.7 * cover;
         // Lighter towards the tip, where the hair is thinner.
-        const double shade = h.shade * (0.85 + 0.35 * along);
-        sum = {sum.r + brow.r * shade * cover, sum.g + brow.g * shade * cover, sum.b + brow.b * shade * cover};
-        weight += cover;
+        if (cover > 0.0) mix.add(brow, cover, 0.7, h.shade * (0.85 + 0.35 * along));
     }
-    if (weight <= 0.0) return 0.0;
-    *colour = sum * (1.0 / weight);
-    return 1.0 - clear;
+    return mix.result(colour);
 }
 
 // Hair of the scalp: 0 (skin) .. 1, and its colour. The strands run from the
