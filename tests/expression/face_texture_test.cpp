@@ -304,7 +304,9 @@ TEST(FaceTexture, AlphaHoldsTheRegionsRoughness) {
     EXPECT_NEAR(cheek, 1.0, 0.02);
     EXPECT_NEAR(crown, 1.0, 0.02);
     EXPECT_LT(lips, cheek - 0.1);
-    EXPECT_LT(nose, cheek - 0.04);  // the T-zone scale is 0.93 (face.json roughness)
+    // The T-zone scale is 0.93 (face.json roughness); this point of the
+    // nose takes 0.4 of it.
+    EXPECT_LT(nose, cheek - 0.02);
 }
 
 // The bust is dressed (face.json shirt): the shoulders are dark cloth, dark
