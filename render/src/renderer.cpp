@@ -201,8 +201,8 @@ DetailMap upload_detail_map(const ImageRGBA8& image, float mean_levels, std::arr
 }
 
 // The pre-integrated scattering table: clamped, bilinear, packed unsigned
-// floats (32 bits a texel: the skin shader samples it five times, and a
-// 64-bit texel filters at half rate).
+// floats (32 bits a texel: the skin shader samples it twice a pixel, for
+// the key, and a 64-bit texel filters at half rate).
 constexpr int kScatterTableWidth = 128;   // N.L
 constexpr int kScatterTableHeight = 64;   // curvature
 GLuint upload_scatter_table(const SkinShading& skin) {
