@@ -708,7 +708,12 @@ void Generator::build_mouth_interior(Face& face) {
                     // height of every gap (a grille).
                     const double w = 0.5 * width + 0.12;
                     if (canine) return w * (f < 0.6 ? detail::mix(0.8, 1.0, f / 0.6) : detail::mix(1.0, 0.25, (f - 0.6) / 0.4));
-                    if (incisor) return w * (f < 0.7 ? detail::mix(0.78, 1.0, f / 0.7) : 1.0);
+                    // An incisor's edge corners are rounded off, so small
+                    // notches (incisal embrasures) part the crowns where
+                    // they show below the lip: square corners meeting
+                    // their neighbours made one flat strip of teeth.
+                    if (incisor)
+                        return w * (f < 0.7 ? detail::mix(0.78, 1.0, f / 0.7) : detail::mix(1.0, 0.86, std::pow((f - 0.7) / 0.3, 1.5)));
                     return w * detail::mix(0.85, 0.95, f);
                 };
                 auto half_b = [&](double f) {

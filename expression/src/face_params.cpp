@@ -172,6 +172,8 @@ FaceParams read_face_params(const std::string& params_dir) {
             p.lower_lip_protrusion = r.number("lower_lip_protrusion");
             p.lip_crease_depth = r.number("crease_depth");
             p.lip_crease_width = r.number("crease_width");
+            p.lower_lip_tuck = r.number_in("lower_lip_tuck", 0.0, 5.0);
+            p.lower_lip_tuck_at = r.number_in("lower_lip_tuck_at", 1.0, 15.0);
             p.mouth_warp_reach = r.number("warp_reach");
             p.outer_corner_offset = r.number("outer_corner_offset");
             for (const char* key : {"half_width", "upper_lip_height", "lower_lip_height"})

@@ -142,6 +142,9 @@ struct FaceParams {
     double cupid_dip = 0.0, cupid_peak_x = 0.0;
     double upper_lip_protrusion = 0.0, lower_lip_protrusion = 0.0;
     double lip_crease_depth = 0.0, lip_crease_width = 0.0;
+    // how far the skin below the lower lip tucks in under it, and that
+    // tuck's distance below the vermilion border (mm)
+    double lower_lip_tuck = 0.0, lower_lip_tuck_at = 0.0;
     double mouth_warp_reach = 0.0;
     double outer_corner_offset = 0.0;
 

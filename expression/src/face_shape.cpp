@@ -256,7 +256,11 @@ double FaceShape::lip_relief(double x, double y) const {
     if (ax > hw + 8.0) return 0.0;
     const double ys = mouth_line(x);
     const double inside = ax < hw ? 1.0 : 0.0;
-    const double corner_fade = inside * std::sqrt(std::max(1.0 - (ax / hw) * (ax / hw), 0.0));
+    // The lips thin out into the corners, where they tuck in under the
+    // modiolus: with the square root of (1 - t^2) they kept most of their
+    // fullness to the corner and ended there as a rounded rim (puffy lips
+    // laid on the face, blind review, session 8).
+    const double corner_fade = inside * std::pow(std::max(1.0 - (ax / hw) * (ax / hw), 0.0), 0.85);
     // The lips roll inwards where they meet: a crease as deep as the mouth
     // line, continuing a little past the corners (the commissures).
     const double along = ax < hw ? 1.0 - 0.4 * std::pow(ax / hw, 4) : 0.6 * std::exp(-std::pow((ax - hw) / 2.5, 2));
@@ -269,7 +273,14 @@ double FaceShape::lip_relief(double x, double y) const {
     } else {
         const double height = std::max(ys - lower_border(x), 0.5);
         const double t = (ys - y) / height;
-        h += p_.lower_lip_protrusion * corner_fade * lip_bulge(t, 0.45, std::max(0.0, ys - y - height), height);
+        const double below = std::max(0.0, ys - y - height);
+        h += p_.lower_lip_protrusion * corner_fade * lip_bulge(t, 0.45, below, height);
+        // Under the lower lip the skin tucks in before the chin (the
+        // mentolabial sulcus' upper wall), so the lip's underside faces down
+        // and holds a shadow: a fall that eased straight into the chin read
+        // as a lip roll stuck on a flat face. Zero slope at the border.
+        const double b = below / p_.lower_lip_tuck_at;
+        h -= p_.lower_lip_tuck * corner_fade * b * b * std::exp(2.0 * (1.0 - b));
     }
     return h;
 }

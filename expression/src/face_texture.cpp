@@ -628,12 +628,25 @@ Texel Painter::skin(glm::dvec3 q) const {
         }
         if (ax < hw + 4.0 && q.z > 60.0) {
             const double up = s_.upper_border(q.x), lo = s_.lower_border(q.x);
+            // The shade under the lower lip, in the tuck above the
+            // mentolabial sulcus (face_shape.cpp): the baked occlusion of a
+            // few mm of tuck is faint under the frontal key, and without a
+            // shade there the lip read as a roll laid on a flat chin.
+            {
+                const double under = lo - q.y;
+                const double band = glm::smoothstep(-0.5, 1.5, under) * (1.0 - glm::smoothstep(3.0, 8.0, under));
+                const double across = 1.0 - glm::smoothstep(0.45 * hw, 0.95 * hw, ax);
+                c = blend(c, c * Rgb{0.8, 0.74, 0.72}, 0.55 * band * across);
+            }
             const double wander = 0.35 * (noise(q.x * 0.6, q.y * 0.6, 3.0) - 0.5);
             const double inside = std::min({up - q.y, q.y - lo, (hw - ax) * 0.6}) + wander;
-            const double border = al.lip_border_mm;
-            const double m = glm::smoothstep(-0.5 * border, 0.8 * border, inside);
             const double line_y = s_.mouth_line(q.x);
             const bool upper = q.y > line_y;
+            // The lower lip's border is softer than the upper's (no white
+            // roll there: its red fades into the shade under the lip); one
+            // crisp edge round both lips outlined them like a prop.
+            const double border = al.lip_border_mm * (upper ? 1.0 : 1.8);
+            const double m = glm::smoothstep(-0.5 * border, 0.8 * border, inside);
             const double roll = (1.0 - glm::smoothstep(0.0, 1.2, std::abs(inside + 0.6 * border))) * (upper ? 1.0 : 0.4);
             c = blend(c, c * 1.03, 0.5 * roll * (1.0 - m));
             if (m > 0) {
@@ -851,7 +864,10 @@ Rgb Painter::tile(double u, double v) const {
         case Tile::Cavity:
             // Lit only through the lips' opening (face_occlusion.cpp), so its
             // albedo stays a mid red to the back: 0.3 there rendered black.
-            return from255(p_.mouth) * (0.6 + 0.4 * std::min(r, 1.0));
+            // 0.6 at the back still read as a shallow red box behind the
+            // teeth (blind review, session 8): the back wall now a deep
+            // shade, the rim by the lips as before.
+            return from255(p_.mouth) * (0.42 + 0.5 * glm::smoothstep(0.2, 1.0, std::min(r, 1.0)));
         case Tile::Teeth: {
             const bool upper = lv >= 0.5;
             const double c = ((upper ? lv - 0.5 : lv) - 0.02) / 0.46 * 3.0;  // 0 root, 1 edge (front), 3 root (back)
@@ -873,7 +889,7 @@ Rgb Painter::tile(double u, double v) const {
             // shade): one even white read as a bright strip of plastic.
             const double crown = std::floor((k - 0.5) * 14.0);
             teeth = teeth * (0.93 + 0.1 * hash(static_cast<int>(crown), upper ? 1 : 2, 211)) *
-                    (1.0 - 0.3 * glm::smoothstep(6.0, 28.0, s));
+                    (1.0 - 0.5 * glm::smoothstep(5.0, 24.0, s));
             // Enamel is thin at the neck, where the yellower, darker dentin
             // shows, and translucent at the biting edge, grey-blue against
             // the dark mouth behind it.
@@ -886,7 +902,11 @@ Rgb Painter::tile(double u, double v) const {
             return blend(teeth, gums * (0.85 + 0.15 * glm::smoothstep(0.1, 0.25, front)), gum);
         }
         case Tile::Tongue:
-            return from255(p_.tongue) * (0.85 + 0.25 * noise(lu * 40, lv * 40, 2.0));
+            // Its tip (the tile's centre) lit through the lips, its body
+            // falling into the mouth's shade: an even red filled the open
+            // mouth as a flat red mass.
+            return from255(p_.tongue) * (0.85 + 0.25 * noise(lu * 40, lv * 40, 2.0)) *
+                   (1.0 - 0.55 * glm::smoothstep(0.12, 0.6, std::min(r, 1.0)));
     }
     return {};
 }

@@ -344,8 +344,9 @@ TEST(FaceTexture, ShirtCoversTheShouldersAndTheNeckEndsAtItsCollar) {
 // The mouth's inside (face_texture.cpp Painter::tile): the teeth are not one
 // even white strip (observers: 'a bright uniform white strip') but ivory,
 // darker from the incisors back along the arch, and the cavity's back is a
-// mid red, not black (the occlusion bake darkens it further; at a third of
-// face.json colours.mouth it rendered as a void).
+// dark red, not black (the occlusion bake darkens it further; at a third of
+// face.json colours.mouth it rendered as a void, and at 0.6 of it the open
+// mouth read as a shallow red box: the back is 0.42 of it now).
 TEST(FaceTexture, TeethDarkenAlongTheArchAndTheCavityIsRed) {
     const double kTile = 0.25;
     // The upper arch's labial faces, mid-crown (0.4..0.75 of the way from
@@ -377,7 +378,7 @@ TEST(FaceTexture, TeethDarkenAlongTheArchAndTheCavityIsRed) {
     EXPECT_LT(incisor.b, incisor.r - 0.08) << "ivory is warm";
     EXPECT_LT(molar.luminance(), 0.88 * incisor.luminance()) << molar.luminance() << " vs " << incisor.luminance();
     const Texel back = texel_at(1.5 * kTile, 0.5 * kTile);
-    EXPECT_GT(back.r, 0.3) << back.r;
+    EXPECT_GT(back.r, 0.22) << back.r;
     EXPECT_GT(back.r, 2.0 * back.g) << back.r << " vs " << back.g;
 }
 
