@@ -364,8 +364,25 @@ FaceParams read_face_params(const std::string& params_dir) {
             }
             {
                 JsonReader g = r.object("pores");
-                a.pore_size = g.number_in("size_mm", 0.1, 5.0);
-                a.pore_strength = g.number_in("strength", 0.0, 0.3);
+                auto& pores = a.pores;
+                pores.spacing = g.number_in("spacing_mm", 0.2, 5.0);
+                pores.size = g.number_in("size_mm", 0.05, 2.0);
+                if (pores.size > pores.spacing) g.at("size_mm").fail("at most spacing_mm (mm)");
+                pores.strength = g.number_in("strength", 0.0, 0.5);
+                pores.base = g.number_in("base", 0.0, 1.0);
+                for (JsonReader& f : g.objects("regions")) {
+                    FaceParams::Flush region;
+                    region.centre = to_glm(f.numbers<2>("centre"));
+                    region.size = to_glm(f.numbers<2>("size"));
+                    if (!(region.size[0] > 0 && region.size[1] > 0)) f.at("size").fail("two widths > 0 (mm)");
+                    region.amount = f.number_in("amount", -1.0, 1.0);
+                    f.finish();
+                    pores.regions.push_back(region);
+                }
+                JsonReader grain = g.object("grain");
+                pores.grain_size = grain.number_in("size_mm", 0.1, 5.0);
+                pores.grain_strength = grain.number_in("strength", 0.0, 0.3);
+                grain.finish();
                 g.finish();
             }
             for (auto [key, spots] : {std::pair{"blemishes", &a.blemishes}, std::pair{"moles", &a.moles}}) {

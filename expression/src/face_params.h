@@ -252,8 +252,16 @@ struct FaceParams {
         std::vector<Tone> tones;
         double flush_breakup = 0.0, ear_flush = 0.0, ear_fold_shade = 0.0;
         double freckle_spacing = 0.0, freckle_size = 0.0, freckle_strength = 0.0;
-        // pore-scale grain: its size (mm) and +- strength
-        double pore_size = 1.0, pore_strength = 0.0;
+        // Pores: pits centred on a jittered 3D lattice (spacing mm), of
+        // radius up to size mm, darkening by up to strength; their strength
+        // and size scale with a regional weight, base plus Gaussian fields
+        // (a negative amount thins them, as on the lids). Grain: the skin's
+        // finer lighter/darker variation, +- grain_strength at grain_size.
+        struct Pores {
+            double spacing = 1.0, size = 0.3, strength = 0.0, base = 1.0;
+            std::vector<Flush> regions;
+            double grain_size = 1.0, grain_strength = 0.0;
+        } pores;
         // sparse small spots: jittered-grid spacing (mm), chance per cell,
         // size (mm, radius 0.5 .. 1.5 times it), strength 0..1
         struct Spots {

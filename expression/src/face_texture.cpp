@@ -488,6 +488,42 @@ double spots(double x, double y, double spacing, double chance, double size, int
     return spot;
 }
 
+// Pores: pits centred on a jittered lattice of `spacing` mm in 3D, each of
+// its own radius, up to 1.25 `size` mm. The surface cuts each pit's sphere
+// at its own depth, so the pits it shows differ in size and depth and lie
+// irregularly, whatever way the surface faces. 0 (none) .. 1 at q.
+double pore_pits(const glm::dvec3& q, double spacing, double size) {
+    const glm::dvec3 f = q / spacing;
+    const int cx = static_cast<int>(std::floor(f.x)), cy = static_cast<int>(std::floor(f.y)),
+              cz = static_cast<int>(std::floor(f.z));
+    const double reach = 1.25 * size / spacing;  // the largest radius, in cells
+    // Points lie in [0.15, 0.85] of their cell: a cell whose range is
+    // farther than the largest radius holds no pit that reaches q.
+    auto gap = [&](double t, int c) { return std::max({0.0, c + 0.15 - t, t - (c + 0.85)}); };
+    double pit = 0.0;
+    for (int dz = -1; dz <= 1; ++dz) {
+        const double gz = gap(f.z, cz + dz);
+        if (gz > reach) continue;
+        for (int dy = -1; dy <= 1; ++dy) {
+            const double gy = gap(f.y, cy + dy);
+            if (gy * gy + gz * gz > reach * reach) continue;
+            for (int dx = -1; dx <= 1; ++dx) {
+                const double gx = gap(f.x, cx + dx);
+                if (gx * gx + gy * gy + gz * gz > reach * reach) continue;
+                const int i = cx + dx, j = cy + dy, k = cz + dz;
+                const int ik = i + 7919 * k;
+                const glm::dvec3 centre{i + 0.15 + 0.7 * hash(ik, j, 301), j + 0.15 + 0.7 * hash(ik, j, 303),
+                                        k + 0.15 + 0.7 * hash(ik, j, 307)};
+                const double radius = reach * (0.6 + 0.4 * hash(ik, j, 311));
+                const glm::dvec3 d = f - centre;
+                const double t = glm::dot(d, d) / (radius * radius);
+                if (t < 1.0) pit = std::max(pit, (1.0 - t) * (1.0 - t));
+            }
+        }
+    }
+    return pit;
+}
+
 Texel Painter::skin(glm::dvec3 q) const {
     // Colour where the symmetric face's curves put it: the shape's
     // asymmetry carries the colour with it.
@@ -510,19 +546,34 @@ Texel Painter::skin(glm::dvec3 q) const {
     // real skin seen close up), with soft irregular shapes (thresholded
     // noise, not discs); a browner set apart (melanin) that darkens a little.
     {
-        const glm::dvec3 b = q / al.blotch_size;
+        // Depth varies a third as fast: where the surface faces the viewer
+        // and curves (the nose's tip), a noise varying as fast in depth as
+        // across drew its thresholded contours as rings round the tip.
+        const glm::dvec3 b = glm::dvec3{q.x, q.y, 0.35 * q.z} / al.blotch_size;
         const double red = glm::smoothstep(0.5, 0.78, fbm(b.x + 3.1, b.y, b.z + 51.0));
         const double brown = glm::smoothstep(0.55, 0.8, fbm(0.7 * b.x, 0.7 * b.y + 5.3, 0.7 * b.z + 57.0));
         c = redden_hue(c, al.blotch_strength * red);
         c = blend(c, c * Rgb{0.95, 0.92, 0.88}, al.blotch_strength * brown);
     }
-    // Pore-scale variation: follicles and the skin's microrelief darken
-    // and lighten it at under a millimetre (the renderer's albedo relief
-    // turns this into fine bumps too).
+    // Pore-scale variation: the skin's grain lightens and darkens it at
+    // under a millimetre, and pores darken it in pits, most on the nose and
+    // the cheeks beside it; the renderer's albedo relief turns both into
+    // fine bumps (the pits into pits).
     {
-        const glm::dvec3 f = q / al.pore_size;
+        const FaceParams::Albedo::Pores& po = al.pores;
+        const glm::dvec3 f = q / po.grain_size;
         const double grain = 0.6 * noise(f.x, f.y, f.z + 70.0) + 0.4 * noise(2.7 * f.x, 2.7 * f.y, 2.7 * f.z);
-        c = c * (1.0 + al.pore_strength * 2.0 * (grain - 0.5));
+        c = c * (1.0 + po.grain_strength * 2.0 * (grain - 0.5));
+        double w = po.base;
+        for (const auto& r : po.regions)
+            w += r.amount * field(r.centre[0] == 0.0 ? q.x : std::abs(q.x), q.y, r.centre[0], r.centre[1], r.size[0], r.size[1]);
+        w = clamp01(w);
+        if (po.strength * w > 0.004) {
+            const double pit = pore_pits(q, po.spacing, po.size * (0.55 + 0.45 * w));
+            // A pore's mouth is shadowed and holds sebum and keratin: darker
+            // and a little browner, not grey.
+            c = blend(c, c * Rgb{0.84, 0.78, 0.74}, std::min(1.0, po.strength / 0.16 * w * pit));
+        }
     }
     const double ax = std::abs(q.x);
     // Forehead: a shade darker and more yellow.
@@ -568,11 +619,13 @@ Texel Painter::skin(glm::dvec3 q) const {
         // Fine capillaries (telangiectasia) on the nose's wings and the
         // cheeks beside them: short meandering red threads where a noise
         // crosses its middle value, only in sparse patches; hue only, so
-        // they stay colour and not ridges.
+        // they stay colour and not ridges. The noise is of x and y alone:
+        // one varying with depth drew its contours round the nose's tip as
+        // the rings of a wood grain.
         {
-            const double where = field(ax, q.y, 16.0, -38.0, 9.0, 7.0) + 0.6 * field(ax, q.y, 30.0, -30.0, 12.0, 9.0);
+            const double where = field(ax, q.y, 16.0, -38.0, 6.0, 6.0) + 0.6 * field(ax, q.y, 30.0, -30.0, 12.0, 9.0);
             if (where > 0.02) {
-                const double thread = 1.0 - glm::smoothstep(0.0, 0.035, std::abs(noise(q.x * 0.7, q.y * 0.7, q.z * 0.7 + 61.0) - 0.5));
+                const double thread = 1.0 - glm::smoothstep(0.0, 0.035, std::abs(noise(q.x * 0.7, q.y * 0.7, 61.0) - 0.5));
                 const double patch = glm::smoothstep(0.55, 0.8, noise(q.x * 0.2, q.y * 0.2, 63.0));
                 c = redden_hue(c, 0.9 * thread * patch * std::min(where, 1.0));
             }

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -380,6 +381,40 @@ TEST(FaceTexture, TeethDarkenAlongTheArchAndTheCavityIsRed) {
     const Texel back = texel_at(1.5 * kTile, 0.5 * kTile);
     EXPECT_GT(back.r, 0.22) << back.r;
     EXPECT_GT(back.r, 2.0 * back.g) << back.r << " vs " << back.g;
+}
+
+// Pores (face.json albedo.pores): pits darker than the skin round them,
+// most on the nose, fewer on the cheeks beside it, none to see on the lids'
+// thin skin. Counted as the share of texels round a point darker than the
+// patch's median by a pit's contrast; the flush, blotches and tones vary
+// over millimetres, far wider than a pit.
+TEST(FaceTexture, PoresAreDarkPitsMostOnTheNoseAndNoneOnTheLids) {
+    const Face& f = painted_face();
+    auto pit_share = [&](double x, double y) {
+        const auto uv = f.mesh.texcoord2D(TriMesh::VertexHandle(front_vertex(x, y)));
+        const Image& img = f.base_colour;
+        const int cx = static_cast<int>(uv[0] * img.width), cy = static_cast<int>((1.0 - uv[1]) * img.height);
+        std::vector<double> lum;
+        constexpr int kR = 8;  // texels: about 3 mm
+        for (int dy = -kR; dy <= kR; ++dy)
+            for (int dx = -kR; dx <= kR; ++dx) {
+                if (dx * dx + dy * dy > kR * kR) continue;
+                const double u = (cx + dx + 0.5) / img.width, v = 1.0 - (cy + dy + 0.5) / img.height;
+                lum.push_back(texel_at(u, v).luminance());
+            }
+        std::vector<double> sorted = lum;
+        std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+        const double median = sorted[sorted.size() / 2];
+        const auto dark = std::count_if(lum.begin(), lum.end(), [&](double l) { return l < 0.93 * median; });
+        return static_cast<double>(dark) / static_cast<double>(lum.size());
+    };
+    const double nose = pit_share(0.0, -25.0), cheek = pit_share(30.0, -24.0), upper_lid = pit_share(31.0, 9.0),
+                 forehead = pit_share(12.0, 45.0);
+    std::printf("pit share: nose %.3f cheek %.3f forehead %.3f upper lid %.3f\n", nose, cheek, forehead, upper_lid);
+    EXPECT_GT(nose, 0.04) << "pores to see on the nose";
+    EXPECT_GT(cheek, 0.01) << "and on the cheeks";
+    EXPECT_GT(nose, 1.5 * cheek);
+    EXPECT_LT(upper_lid, 0.25 * nose) << "the lids' pores are finer than a texel";
 }
 
 }  // namespace
