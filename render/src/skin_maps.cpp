@@ -92,6 +92,38 @@ std::vector<std::uint8_t> pore_map(const PoreMapSpec& spec) {
     const int n = spec.size;
     const double cell = double(n) / spec.cells;
     std::vector<double> height(std::size_t(n) * n, 0.0), pit(std::size_t(n) * n, 0.0);
+    // The skin's microrelief: furrows in three families of lines that cross
+    // (two steep, the third shallower), about one to a pore cell apart,
+    // cutting the surface into small plateaus. Each family is the level
+    // lines of a x + b y (integer a, b: so it tiles), warped by smooth
+    // noise so the lines meander, and deepening and fading along them.
+    struct Family {
+        double a, b, weight;
+        std::uint32_t seed;
+    };
+    std::array<Family, 3> families{};
+    {
+        const double count = 0.8 * spec.cells;  // lines across the tile per family
+        const double angles[3] = {0.35, 1.45, 2.5}, weights[3] = {1.0, 0.85, 0.5};
+        for (int k = 0; k < 3; ++k)
+            families[std::size_t(k)] = {std::round(count * std::cos(angles[k])), std::round(count * std::sin(angles[k])),
+                                        weights[k], spec.seed + 101u + 17u * std::uint32_t(k)};
+    }
+    const double spacing = n / (0.8 * spec.cells);  // texels between a family's lines
+    auto furrows = [&](double x, double y) {
+        double sum = 0.0;
+        for (const Family& fam : families) {
+            const double length = std::hypot(fam.a, fam.b);
+            const double warp = 0.45 * (periodic_noise(x * 5.0 / n, y * 5.0 / n, 5, fam.seed) - 0.5) +
+                                0.25 * (periodic_noise(x * 13.0 / n, y * 13.0 / n, 13, fam.seed + 1u) - 0.5);
+            const double phase = (fam.a * x + fam.b * y) / n + warp;
+            const double across = std::abs(phase - std::round(phase)) * n / length;  // texels to the line
+            const double width = 0.13 * spacing;
+            const double depth = 0.3 + 0.7 * periodic_noise(x * 24.0 / n, y * 24.0 / n, 24, fam.seed + 2u);
+            sum += fam.weight * depth * std::exp(-across * across / (width * width));
+        }
+        return std::min(sum, 1.5);
+    };
     // Pit centres and radii, one per cell, jittered.
     std::vector<double> cx(std::size_t(spec.cells) * spec.cells), cy(cx.size()), radius(cx.size());
     for (int j = 0; j < spec.cells; ++j)
@@ -118,13 +150,12 @@ std::vector<std::uint8_t> pore_map(const PoreMapSpec& spec) {
                     const double q = (dx * dx + dy * dy) / (radius[k] * radius[k]);
                     if (q < 1.0) depth = std::max(depth, (1.0 - q) * (1.0 - q));
                 }
-            // Fine relief: two octaves of value noise on lattices of 4 and
-            // 2 texels, whose periods divide the tile.
-            const double f = 0.65 * periodic_noise(x / 4.0, y / 4.0, n / 4, spec.seed + 7u) +
-                             0.35 * periodic_noise(x / 2.0, y / 2.0, n / 2, spec.seed + 11u);
             const std::size_t idx = std::size_t(y) * n + x;
             pit[idx] = depth;
-            height[idx] = spec.noise_scale * f - spec.pit_depth * depth;
+            // Beside the furrows, a faint fine roughness: value noise on a
+            // lattice of 2 texels, whose period divides the tile.
+            const double f = periodic_noise(x / 2.0, y / 2.0, n / 2, spec.seed + 11u);
+            height[idx] = spec.noise_scale * (0.5 * f - 2.0 * furrows(x + 0.5, y + 0.5)) - spec.pit_depth * depth;
         }
     // Normals from central differences (wrapping), scaled so the steepest
     // slope tilts the normal by 45 degrees; the shader scales the tilt.

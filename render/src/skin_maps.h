@@ -19,8 +19,12 @@ namespace emoface::render::detail {
 std::vector<float> preintegrated_scatter_table(const SkinShading& skin, int width, int height);
 
 // The pore map: spec.size^2 RGBA8 texels, tileable, deterministic for a spec.
+// Pits (one per cell of a jittered cells x cells grid) over the skin's
+// microrelief: furrows in three families of meandering lines that cross,
+// about 0.8 cells apart (2 noise_scale deep), and a faint fine noise.
 // RGB = 0.5 + 0.5 n (n.x along the tile's columns, n.y along its rows, n.z
-// out of the skin); A = cavity, 255 on open skin, lower in the pits.
+// out of the skin); A = cavity, 255 on open skin, lower in the pits (the
+// furrows are too shallow to hold light: a cavity there dimmed all skin).
 std::vector<std::uint8_t> pore_map(const PoreMapSpec& spec);
 
 // The base colour's fine relief, baked once so the shader needs neither a

@@ -778,6 +778,57 @@ TEST(SkinMaps, ScatterTablesFlattestRowIsLambert) {
     EXPECT_GT(top, 2.0f * worst) << "top row " << top << ", flattest " << worst;
 }
 
+// The pore map (skin_maps.h): pits over a network of furrows that cross
+// (the skin's microrelief), tiling without a seam.
+TEST(SkinMaps, PoreMapIsPitsOverCrossingFurrowsAndTiles) {
+    emoface::render::PoreMapSpec spec;
+    const int n = spec.size;
+    const std::vector<std::uint8_t> map = emoface::render::detail::pore_map(spec);
+    ASSERT_EQ(map.size(), std::size_t(n) * n * 4);
+    auto at = [&](const std::vector<std::uint8_t>& m, int x, int y, int c) {
+        return int(m[(std::size_t((y + n) % n) * n + std::size_t((x + n) % n)) * 4 + std::size_t(c)]);
+    };
+    // Tiles: the normal steps across the tile's edge no more than between
+    // neighbours inside it.
+    double inside = 0.0, seam = 0.0;
+    for (int k = 0; k < n; ++k)
+        for (int c = 0; c < 2; ++c) {
+            seam += std::abs(at(map, n - 1, k, c) - at(map, 0, k, c)) + std::abs(at(map, k, n - 1, c) - at(map, k, 0, c));
+            inside += std::abs(at(map, n / 2 - 1, k, c) - at(map, n / 2, k, c)) +
+                      std::abs(at(map, k, n / 2 - 1, c) - at(map, k, n / 2, c));
+        }
+    EXPECT_LT(seam, 1.5 * inside) << "a seam at the tile's edge";
+    // Pits: deep cavities on mostly open skin.
+    int deepest = 255;
+    double mean = 0.0;
+    for (int i = 0; i < n * n; ++i) {
+        deepest = std::min(deepest, int(map[std::size_t(i) * 4 + 3]));
+        mean += map[std::size_t(i) * 4 + 3];
+    }
+    mean /= double(n) * n;
+    EXPECT_LT(deepest, 150);
+    EXPECT_GT(mean, 0.8 * 255.0);
+    // Without the pits, the furrows' relief remains, and it runs every way
+    // (families of lines that cross, not one grain): the normals' tilt,
+    // binned by its axis, has weight in every bin.
+    spec.pit_depth = 0.0f;
+    const std::vector<std::uint8_t> furrows = emoface::render::detail::pore_map(spec);
+    constexpr int kBins = 6;
+    std::array<double, kBins> tilt{};
+    double mean_tilt = 0.0;
+    for (int i = 0; i < n * n; ++i) {
+        const double x = furrows[std::size_t(i) * 4] / 127.5 - 1.0, y = furrows[std::size_t(i) * 4 + 1] / 127.5 - 1.0;
+        double axis = std::atan2(y, x);
+        if (axis < 0.0) axis += 3.14159265358979;
+        tilt[std::size_t(std::min(kBins - 1, int(axis / 3.14159265358979 * kBins)))] += x * x + y * y;
+        mean_tilt += std::hypot(x, y);
+    }
+    mean_tilt /= double(n) * n;
+    EXPECT_GT(mean_tilt, 0.1) << "relief between the pits";
+    const double total = tilt[0] + tilt[1] + tilt[2] + tilt[3] + tilt[4] + tilt[5];
+    for (int b = 0; b < kBins; ++b) EXPECT_GT(tilt[std::size_t(b)], 0.3 * total / kBins) << "tilts about axis bin " << b;
+}
+
 // SkinShading's defaults are data/render/skin.json's values.
 TEST(SkinShadingData, DefaultsAreTheDataFile) {
     const SkinShading loaded = load_skin_shading(std::string(EMOFACE_DATA_DIR) + "/render/skin.json");
