@@ -5,9 +5,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdio>
 #include <string>
+#include <vector>
 
+#include "emoface/common/constants.h"
 #include "emoface/expression/action_units.h"
 #include "emoface/expression/profiles.h"
 #include "test_face.h"
@@ -18,6 +22,7 @@ namespace {
 using testing::fp;
 using testing::test_face;
 using testing::test_rig;
+using testing::to_vec;
 
 const EmotionProfiles& profiles() {
     static const EmotionProfiles p = load_emotion_profiles(std::string(EMOFACE_DATA_DIR) + "/expression/emotions.json");
@@ -85,6 +90,84 @@ TEST(RigCheek, ASmileBringsTheCheekForwardAndUpBesideADeeperFold) {
         EXPECT_LE(r.forward, c.forward_max);
         EXPECT_GE(r.fold, c.fold_min);
     }
+}
+
+// The smiling cheek is a rounded mound: no line runs from below the eye
+// down the cheek (issue 11: joy showed a sharp ridge from the outer eye
+// corner towards the mouth corner, along the grid's vertical edge line
+// through the cheek point, where distances along edges alone bent the cheek
+// kernel). Measured as the largest growth over neutral of the dihedral
+// angle between neighbouring skin triangles in a band down the cheekbone:
+// within 10 mm of the cheek point's x, from 10 mm below the lower lid's
+// point (above: the lid's bulge) to 20 mm above the mouth corner (below:
+// the corner's own crowding, the modiolus).
+double largest_cheek_crease(const FapValues& faps, bool left, Vec3d* where) {
+    const Face& face = test_face();
+    const TriMesh& mesh = face.mesh;
+    const Vec3d cheek = face.position(fp(left ? "5.3" : "5.4")), corner = face.position(fp(left ? "8.3" : "8.4"));
+    const Vec3d lid = face.position(fp(left ? "3.3" : "3.4"));
+    const DeformedFace out = test_rig().deform(faps);
+    auto normal = [&](TriMesh::FaceHandle f, bool deformed) {
+        std::array<Vec3d, 3> p{};
+        int i = 0;
+        for (auto v : mesh.fv_range(f)) p[i++] = to_vec(deformed ? out.positions[v.idx()] : mesh.point(v));
+        const Vec3d a{p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]};
+        const Vec3d b{p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]};
+        Vec3d n{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+        const double l = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        for (double& c : n) c /= l > 0 ? l : 1.0;
+        return n;
+    };
+    auto angle = [&](TriMesh::FaceHandle f, TriMesh::FaceHandle g, bool deformed) {
+        const Vec3d a = normal(f, deformed), b = normal(g, deformed);
+        return std::acos(std::clamp(a[0] * b[0] + a[1] * b[1] + a[2] * b[2], -1.0, 1.0)) * 180.0 / kPi;
+    };
+    double worst = 0.0;
+    for (auto e : mesh.edges()) {
+        if (mesh.is_boundary(e)) continue;
+        const auto h = mesh.halfedge_handle(e, 0);
+        const int a = mesh.from_vertex_handle(h).idx(), b = mesh.to_vertex_handle(h).idx();
+        if (face.parts[a] != VertexPart::Skin || face.parts[b] != VertexPart::Skin) continue;
+        const Vec3d pa = to_vec(mesh.point(TriMesh::VertexHandle(a))), pb = to_vec(mesh.point(TriMesh::VertexHandle(b)));
+        const Vec3d mid{0.5 * (pa[0] + pb[0]), 0.5 * (pa[1] + pb[1]), 0.5 * (pa[2] + pb[2])};
+        if (std::abs(mid[0] - cheek[0]) > 10.0 || mid[1] > lid[1] - 10.0 || mid[1] < corner[1] + 20.0 ||
+            mid[2] < cheek[2] - 15.0)
+            continue;
+        const auto f = mesh.face_handle(h), g = mesh.face_handle(mesh.opposite_halfedge_handle(h));
+        const double growth = angle(f, g, true) - angle(f, g, false);
+        if (growth > worst) worst = growth, *where = mid;
+    }
+    return worst;
+}
+
+TEST(RigCheek, TheSmilingCheekHasNoRidgeDownIt) {
+    const ActionUnitTable& aus = profiles().action_units;
+    auto au = [&](int n) { return aus.find(n)->faps; };
+    FapValues au6_12 = au(6);
+    for (std::size_t i = 0; i < au6_12.size(); ++i) au6_12[i] += au(12)[i];
+    struct Case {
+        std::string what;
+        FapValues faps;
+    };
+    const Case cases[] = {
+        {"joy", profiles()[Emotion::Joy]},
+        {"AU6 cheek raiser", au(6)},
+        {"AU12 lip corner puller", au(12)},
+        {"AU6+AU12", au6_12},
+    };
+    // Between triangles of about 2.5 mm (the half-resolution test face) the
+    // mound bends each edge by up to about 7 degrees; the ridge along the
+    // edge line grew it by 10-14 (joy, AU6, AU6+AU12).
+    constexpr double kBound = 9.0;
+    for (const Case& c : cases)
+        for (const bool left : {true, false}) {
+            Vec3d at{};
+            const double g = largest_cheek_crease(c.faps, left, &at);
+            std::printf("%-24s %s cheek: largest crease growth %5.1f deg at (%.1f, %.1f, %.1f)\n", c.what.c_str(),
+                        left ? "left " : "right", g, at[0], at[1], at[2]);
+            EXPECT_LE(g, kBound) << c.what << (left ? ", left" : ", right") << " cheek at (" << at[0] << ", " << at[1]
+                                 << ", " << at[2] << ")";
+        }
 }
 
 }  // namespace
