@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <random>
 
 #include "emoface/common/constants.h"
@@ -37,6 +38,9 @@ struct Row {
     double origin_y = 0;
     double z_front = 0, z_back = 0;
     double angle_front = 0, angle_back = 0;  // radians
+    // A bust row (> 0): not a ray but the point this share of the column's
+    // bust length along the body's profile below the lowest ray row.
+    double bust_share = 0;
 
     static double front_weight(double theta) { return 0.5 * (1.0 + std::cos(theta)); }
     glm::dvec3 origin(double theta) const { return {0.0, origin_y, detail::mix(z_back, z_front, front_weight(theta))}; }
@@ -82,6 +86,7 @@ public:
 
 private:
     glm::dvec3 base_point(double theta, const Row& row, double dphi) const {
+        if (row.bust_share > 0) return bust_point(theta, row.bust_share);
         const glm::dvec3 o = row.origin(theta);
         const glm::dvec3 d = ray_dir(theta, row.angle(theta) + dphi);
         return o + d * shape_.cast(o, d);
@@ -104,6 +109,7 @@ private:
         return dphi;
     }
 
+    glm::dvec3 bust_point(double theta, double share) const;
     void make_columns();
     std::vector<Row> resample(const std::vector<detail::RowKey>& keys) const;
     void make_rows();
@@ -153,7 +159,12 @@ private:
     std::vector<double> theta_;  // ncols_ + 1 azimuths, first and last the same seam
     int ncols_ = 0;
     int centre_col_ = 0;
-    std::vector<Row> rows_;  // bottom (neck) to top (crown)
+    std::vector<Row> rows_;  // bottom (bust) to top (crown)
+    Row lowest_ray_row_;     // where the bust rows start
+    int bust_rows_ = 0;      // the bottom rows are the bust's
+    // per column azimuth: the body's profile below the lowest ray row, 1 mm
+    // steps (filled as the bust rows are made)
+    mutable std::map<double, std::vector<glm::dvec3>> bust_profiles_;
     int eye_row_ = 0, mouth_row_ = 0, mouth_row_down_ = 0, mouth_key_ = 0;
     double mouth_angle_ = 0;
     // Per column: elevation offsets of the rows above / below each slit.
@@ -219,6 +230,54 @@ std::vector<Row> Generator::resample(const std::vector<detail::RowKey>& keys) co
     return out;
 }
 
+// The body's profile in the column's plane (through the lowest ray row's
+// origin, at azimuth theta), traced from that row's point down and out: each
+// step goes along the surface's tangent in the plane (the outward normal
+// turned clockwise: down the neck, out along the shoulders, down the chest)
+// and is pulled back onto the surface along the field's gradient.
+glm::dvec3 Generator::bust_point(double theta, double share) const {
+    const double c = std::cos(theta);
+    const glm::dvec3& len = p_.bust_length_mm;
+    const double length = len[1] + ((c >= 0 ? len[0] : len[2]) - len[1]) * std::sqrt(std::abs(c));
+    auto it = bust_profiles_.find(theta);
+    if (it == bust_profiles_.end()) {
+        const glm::dvec3 o = lowest_ray_row_.origin(theta);
+        const glm::dvec3 h{std::sin(theta), 0.0, c};
+        auto at = [&](glm::dvec2 q) { return glm::dvec3{q.x * h.x, q.y, o.z + q.x * h.z}; };
+        auto gradient = [&](glm::dvec2 q) {
+            constexpr double e = 0.05;
+            return glm::dvec2{shape_.field(at(q + glm::dvec2{e, 0})) - shape_.field(at(q - glm::dvec2{e, 0})),
+                              shape_.field(at(q + glm::dvec2{0, e})) - shape_.field(at(q - glm::dvec2{0, e}))} /
+                   (2.0 * e);
+        };
+        const glm::dvec3 start = base_point(theta, lowest_ray_row_, 0.0);
+        glm::dvec2 q{glm::dot(start - o, h), start.y};
+        std::vector<glm::dvec3> profile{at(q)};
+        constexpr double kStep = 1.0;
+        for (double walked = 0.0; walked < length + kStep;) {
+            const glm::dvec2 g = gradient(q);
+            glm::dvec2 next = q + glm::normalize(glm::dvec2{g.y, -g.x}) * kStep;
+            for (int k = 0; k < 3; ++k) {
+                const glm::dvec2 gn = gradient(next);
+                next -= shape_.field(at(next)) * gn / std::max(glm::dot(gn, gn), 1e-12);
+            }
+            walked += glm::length(next - q);
+            q = next;
+            profile.push_back(at(q));
+        }
+        it = bust_profiles_.emplace(theta, std::move(profile)).first;
+    }
+    const std::vector<glm::dvec3>& profile = it->second;
+    double target = share * length;
+    for (std::size_t k = 1; k < profile.size(); ++k) {
+        const double step = glm::length(profile[k] - profile[k - 1]);
+        if (target <= step || k + 1 == profile.size())
+            return profile[k - 1] + (profile[k] - profile[k - 1]) * std::min(target / std::max(step, 1e-12), 1.0);
+        target -= step;
+    }
+    return profile.back();
+}
+
 void Generator::make_rows() {
     const auto& lk = p_.lower_rows;
     const auto& uk = p_.upper_rows;
@@ -264,6 +323,25 @@ void Generator::make_rows() {
     const std::vector<Row> up = resample(uk);
 
     rows_.assign(down.rbegin(), down.rend());
+    // The bust below: rows along the body's profile (face.json
+    // resolution.bust), the first rows close (the collar's edge lies there),
+    // widening evenly out along the shoulders. Rays cast out from the neck's
+    // axis graze the shoulders' slope: its rows bunched on the neck and
+    // jumped to the shoulders' rim, a flat disc streaked along its rows.
+    lowest_ray_row_ = rows_.front();
+    {
+        const int n = scaled(p_.bust_rows, scale_, p_.bust_rows > 0 ? 2 : 0);
+        const double a = p_.bust_first_share;
+        std::vector<Row> bust;
+        for (int j = n; j >= 1; --j) {
+            const double u = static_cast<double>(j) / n;
+            Row r = lowest_ray_row_;
+            r.bust_share = a * u + (1.0 - a) * u * u;
+            bust.push_back(r);
+        }
+        rows_.insert(rows_.begin(), bust.begin(), bust.end());
+        bust_rows_ = n;
+    }
     eye_row_ = static_cast<int>(rows_.size());
     mouth_row_ = eye_row_ - 1 - mouth_row_down_;
     rows_.push_back(to_row(lk[0]));
@@ -371,7 +449,27 @@ void Generator::build_skin(Face& face) {
         d += mouth_dphi_[i] * warp_falloff(std::abs(j - mouth_row_), mouth_reach);
         return d;
     };
-    auto v_of = [&](int j) { return detail::kSkinV0 + (0.995 - detail::kSkinV0) * j / (nrows - 1); };
+    // Each row gap takes the same height of texture, but the bust's (a
+    // few mm to a few cm apart) take bust.texture_rows in all, each in
+    // inverse proportion to its spacing: most where the rows are closest,
+    // round the collar, whose edge one texture row per 5 mm (one per row
+    // gap) blurred across the rows at the mip level the columns' denser u
+    // picks; least out on the shoulders, plain cloth.
+    std::vector<double> below(static_cast<std::size_t>(nrows), 0.0);
+    {
+        const double a = p_.bust_first_share;
+        auto share = [&](double u) { return a * u + (1.0 - a) * u * u; };
+        std::vector<double> w(static_cast<std::size_t>(bust_rows_));
+        double sum = 0.0;
+        for (int j = 0; j < bust_rows_; ++j) {
+            const int k = bust_rows_ - 1 - j;  // gaps counted from the neck
+            w[j] = 1.0 / (share(static_cast<double>(k + 1) / bust_rows_) - share(static_cast<double>(k) / bust_rows_));
+            sum += w[j];
+        }
+        const double total = p_.bust_rows > 0 ? p_.bust_texture_rows * bust_rows_ / p_.bust_rows : 0.0;
+        for (int j = 1; j < nrows; ++j) below[j] = below[j - 1] + (j - 1 < bust_rows_ ? total * w[j - 1] / sum : 1.0);
+    }
+    auto v_of = [&](int j) { return detail::kSkinV0 + (0.995 - detail::kSkinV0) * below[j] / below.back(); };
 
     for (int j = 0; j < nrows; ++j) {
         for (int i = 0; i <= ncols_; ++i) {

@@ -71,6 +71,17 @@ FaceParams read_face_params(const std::string& params_dir) {
             p.row_spacing = r.number_in("row_spacing_mm", 0.2, 50);
             p.upper_rows = read_row_keys(r, "upper_rows");
             p.lower_rows = read_row_keys(r, "lower_rows");
+            {
+                JsonReader b = r.object("bust");
+                p.bust_rows = b.integer_in("rows", 0, 200);
+                p.bust_length_mm = to_glm(b.numbers<3>("length_mm"));
+                for (int c = 0; c < 3; ++c)
+                    if (!(p.bust_length_mm[c] >= 1.0 && p.bust_length_mm[c] <= 500.0))
+                        b.at("length_mm").fail("lengths in 1..500 mm (front, side, back)");
+                p.bust_first_share = b.number_in("first_share", 0.1, 1.0);
+                p.bust_texture_rows = b.number_in("texture_rows", 1.0, 200.0);
+                b.finish();
+            }
             p.eyeball_rings = r.integer_in("eyeball_rings", 6, 512);
             p.eyeball_segments = r.integer_in("eyeball_segments", 8, 512);
             p.texture_size = r.integer_in("texture_size", 16, 8192);
@@ -445,6 +456,14 @@ FaceParams read_face_params(const std::string& params_dir) {
             s.rib_mm = r.number_in("rib_mm", 0.5, 10.0);
             s.rib_contrast = r.number_in("rib_contrast", 0.0, 0.2);
             s.seam_shade = r.number_in("seam_shade", 0.0, 0.5);
+            s.collar_roll = r.number_in("collar_roll", 0.0, 0.5);
+            s.edge_mm = r.number_in("edge_mm", 0.1, 5.0);
+            s.thickness_mm = to_glm(r.numbers<2>("thickness_mm"));
+            if (!(s.thickness_mm[0] >= 0.0 && s.thickness_mm[0] <= 6.0 && s.thickness_mm[1] >= 0.0 &&
+                  s.thickness_mm[1] <= s.thickness_mm[0]))
+                r.at("thickness_mm").fail("[collar, body] in 0..6 mm, the body no thicker than the collar");
+            s.weave_mm = r.number_in("weave_mm", 0.3, 5.0);
+            s.weave = r.number_in("weave", 0.0, 0.2);
             s.folds = r.number_in("folds", 0.0, 0.3);
             s.fold_count = r.number_in("fold_count", 0.0, 20.0);
             s.mottling = r.number_in("mottling", 0.0, 0.2);

@@ -88,6 +88,15 @@ struct FaceParams {
     std::vector<RowKey> upper_rows;  // from eye level (angle 0) up to the crown
     std::vector<RowKey> lower_rows;  // from eye level down to the neck's cut
     double row_spacing = 0.0;        // mm between rows where a key gives none
+    // below the last lower row, rows that follow the body's profile down the
+    // chest and out along the shoulders (face.json resolution.bust): how
+    // many, how far (mm along the profile: in front, at the sides, behind),
+    // and the first row's spacing as a share of the mean (the rest widen
+    // evenly)
+    int bust_rows = 0;
+    glm::dvec3 bust_length_mm{0.0};
+    double bust_first_share = 1.0;
+    double bust_texture_rows = 0.0;  // texture height of the bust's rows, in rows above
     int eyeball_rings = 0, eyeball_segments = 0;
     int texture_size = 0;
 
@@ -295,6 +304,9 @@ struct FaceParams {
         double neckline_front = 0.0, neckline_side = 0.0, neckline_back = 0.0;
         double dip_half_angle_deg = 1.0;
         double collar_mm = 0.0, collar_shade = 1.0, rib_mm = 1.0, rib_contrast = 0.0, seam_shade = 0.0;
+        double collar_roll = 0.0, edge_mm = 1.0;  // the collar's rolled top edge; the neck-to-collar edge's width
+        glm::dvec2 thickness_mm{0.0};              // how far the collar and the body stand off the skin
+        double weave_mm = 1.0, weave = 0.0;        // the jersey's wales: spacing, contrast
         double folds = 0.0, fold_count = 0.0, mottling = 0.0;
         double neck_shade_mm = 0.0, neck_shade = 0.0;
     } shirt;

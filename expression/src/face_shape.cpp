@@ -574,7 +574,44 @@ glm::dvec3 FaceShape::displace(glm::dvec3 base) const {
     }
     const double hair = hair_thickness(base, n);
     if (hair > 0.0) p = p + n * hair;
+    const double cloth = shirt_thickness(base);
+    if (cloth > 0.0) p = p + n * cloth;
     return p + asymmetry(base);
+}
+
+FaceShape::ShirtPlace FaceShape::shirt_place(glm::dvec3 q) const {
+    const FaceParams::Shirt& sh = p_.shirt;
+    // Azimuth about the neck's leaning axis (0 in front, pi at the back),
+    // on the neck's elliptic section so it is even round the neck.
+    const double axis_z = p_.neck_centre_z + (q.y - p_.neck_top_y) * neck_lean_tan_;
+    const double dz = q.z - axis_z;
+    const double ax = std::abs(q.x);
+    const double dip = sh.dip_half_angle_deg * kPi / 180.0;
+    // The neckline's height at azimuth a: a flat-bottomed dip in front
+    // rising to the sides, then on up behind them at once (over the
+    // trapezius' slope, which stands above the side's height just behind
+    // the neck: a slower rise left a rim of skin on the shoulders' outline).
+    auto neckline = [&](double a) {
+        if (a < 0.5 * kPi) return mix(sh.neckline_front, sh.neckline_side, glm::smoothstep(0.0, dip, a));
+        return mix(sh.neckline_side, sh.neckline_back, std::sin(a - 0.5 * kPi));
+    };
+    const double a = std::atan2(ax / p_.neck_radii[0], dz / p_.neck_radii[1]);
+    const double r = std::max(std::hypot(ax, dz), 30.0);  // mm per radian along the neck's surface
+    constexpr double kDa = 0.01;
+    const double slope = (neckline(std::min(a + kDa, kPi)) - neckline(std::max(a - kDa, 0.0))) / (2.0 * kDa * r);
+    return {(neckline(a) - q.y) / std::sqrt(1.0 + slope * slope), (q.x < 0 ? -1.0 : 1.0) * r * a};
+}
+
+double FaceShape::shirt_thickness(glm::dvec3 base) const {
+    const FaceParams::Shirt& sh = p_.shirt;
+    if (base.y > std::max({sh.neckline_front, sh.neckline_side, sh.neckline_back}) + 2.0) return 0.0;
+    const double below = shirt_place(base).below;
+    if (below <= 0.0) return 0.0;
+    // The collar's folded band stands off the neck by its thickness, its
+    // top edge rounded over about its thickness; the body's single layer
+    // is thinner.
+    const double band = 1.0 - glm::smoothstep(sh.collar_mm - 2.0, sh.collar_mm + 2.0, below);
+    return glm::smoothstep(0.0, 1.2 * sh.thickness_mm[0], below) * mix(sh.thickness_mm[1], sh.thickness_mm[0], band);
 }
 
 // No face is its mirror image (FIDELITY.md, "Perfect, symmetric"): the

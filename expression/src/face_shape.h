@@ -144,6 +144,18 @@ public:
     // outward normal n (0 below the hairline).
     double hair_thickness(glm::dvec3 base, glm::dvec3 n) const;
 
+    // Where q lies against the T-shirt's collar (face.json shirt): how far
+    // below its edge across the neckline's curve (mm; < 0 on the neck above
+    // it), and how far round the neck from the front (mm along the neck's
+    // surface, signed as x), the same for the cloth's thickness and its paint.
+    struct ShirtPlace {
+        double below, around;
+    };
+    ShirtPlace shirt_place(glm::dvec3 q) const;
+    // How far the shirt stands off the skin at a head-volume point (0 on
+    // the neck above the collar).
+    double shirt_thickness(glm::dvec3 base) const;
+
     // Depth of the nostril dents at (x, y) as a fraction 0..1 (for painting).
     double nostril_amount(double x, double y) const;
 

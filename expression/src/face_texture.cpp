@@ -849,55 +849,47 @@ Texel Painter::skin(glm::dvec3 q) const {
 Rgb Painter::shirt(glm::dvec3 q, Rgb c, double* gloss) const {
     const FaceParams::Shirt& sh = p_.shirt;
     if (q.y > std::max({sh.neckline_front, sh.neckline_side, sh.neckline_back}) + sh.neck_shade_mm + 2.0) return c;
-    // Azimuth about the neck's leaning axis (0 in front, pi at the back),
-    // on the neck's elliptic section so it is even round the neck.
-    const double lean = std::tan(glm::radians(p_.neck_lean_deg));
-    const double axis_z = p_.neck_centre_z + (q.y - p_.neck_top_y) * lean;
-    const double dz = q.z - axis_z;
+    const FaceShape::ShirtPlace place = s_.shirt_place(q);
+    const double below = place.below;
     const double ax = std::abs(q.x);
-    const double dip = glm::radians(sh.dip_half_angle_deg);
-    // The neckline's height at azimuth a: a flat-bottomed dip in front
-    // rising to the sides, then on up behind them at once (over the
-    // trapezius' slope, which stands above the side's height just behind
-    // the neck: a slower rise left a rim of skin on the shoulders' outline).
-    auto neckline = [&](double a) {
-        if (a < 0.5 * kPi)
-            return mix(sh.neckline_front, sh.neckline_side, glm::smoothstep(0.0, dip, a));
-        return mix(sh.neckline_side, sh.neckline_back, std::sin(a - 0.5 * kPi));
-    };
-    const double a = std::atan2(ax / p_.neck_radii[0], dz / p_.neck_radii[1]);
-    const double r = std::max(std::hypot(ax, dz), 30.0);  // mm per radian along the neck's surface
-    constexpr double kDa = 0.01;
-    const double slope = (neckline(std::min(a + kDa, kPi)) - neckline(std::max(a - kDa, 0.0))) / (2.0 * kDa * r);
-    // Distance below the neckline across the curve (mm; < 0 on the neck).
-    const double below = (neckline(a) - q.y) / std::sqrt(1.0 + slope * slope);
     if (below < 0.0) {
         const double shade = sh.neck_shade * (1.0 - glm::smoothstep(0.0, sh.neck_shade_mm, -below));
         return c * (1.0 - shade);
     }
     // Cloth: broad mottling and a few soft folds fanning from the neck's
-    // base out to the shoulders, wandering; nothing fine.
+    // base out to the shoulders, wandering, under a fine jersey weave (its
+    // wales run down the body, about weave_mm apart: the base map's relief
+    // turns them into a faint texture that catches the light).
     Rgb cloth = from255(sh.colour);
     const double broad = fbm(q.x * 0.02, q.y * 0.02, q.z * 0.02 + 91.0) - 0.5;
     const double fan = std::atan2(sh.neckline_side + 20.0 - q.y, ax + 1.0);  // 0 across to the shoulder .. pi/2 down the chest
     const double wander = 1.2 * (noise(q.x * 0.015, q.y * 0.015, 93.0) - 0.5);
     const double fold = std::sin(sh.fold_count * 2.0 * fan + wander + (q.x < 0 ? 0.7 : 0.0));
     const double fold_reach = glm::smoothstep(0.0, 12.0, below) * (1.0 - 0.6 * glm::smoothstep(40.0, 120.0, below));
-    cloth = cloth * (1.0 + 2.0 * sh.mottling * broad + sh.folds * fold * fold_reach);
-    // The collar: a ribbed band below the neckline, its ribs across it, a
-    // thin shadow along the seam under it.
+    // The wales follow the columns (about 80 mm of arc per radian of
+    // azimuth round the body), so the texture's coarser rows on the
+    // shoulders cannot alias them; they fade out there, where they would be
+    // a few mm apart.
+    const double weave = std::cos(2.0 * kPi * 80.0 * std::atan2(q.x, q.z + 30.0) / sh.weave_mm) *
+                         (1.0 - glm::smoothstep(70.0, 110.0, ax));
+    cloth = cloth * (1.0 + 2.0 * sh.mottling * broad + sh.folds * fold * fold_reach + sh.weave * weave);
+    // The collar: a ribbed band below the neckline, its ribs across it, its
+    // folded top edge rounded (lighter where it turns up to the light, a
+    // shade darker under it), a thin shadow along the seam under it.
     if (below < sh.collar_mm + 2.0) {
         const double band = 1.0 - glm::smoothstep(sh.collar_mm - 0.5, sh.collar_mm + 0.5, below);
-        const double rib = std::cos(2.0 * kPi * r * a / sh.rib_mm);
-        Rgb collar = from255(sh.colour) * (sh.collar_shade * (1.0 + 2.0 * sh.mottling * broad) + sh.rib_contrast * rib);
+        const double rib = std::cos(2.0 * kPi * place.around / sh.rib_mm);
+        const double roll = std::exp(-std::pow((below - 1.2) / 1.0, 2)) - 0.5 * std::exp(-std::pow((below - 3.2) / 0.9, 2));
+        Rgb collar = from255(sh.colour) * (sh.collar_shade * (1.0 + 2.0 * sh.mottling * broad) + sh.rib_contrast * rib +
+                                           sh.collar_roll * roll);
         cloth = blend(cloth, collar, band);
         const double seam = std::exp(-std::pow((below - sh.collar_mm) / 0.8, 2));
         cloth = cloth * (1.0 - sh.seam_shade * seam);
     }
-    // Softened over 2 mm: the rows below the neck are 6 mm apart and get
-    // few texels (v is linear in the row), so a sharper edge renders as a
-    // staircase.
-    const double cover = glm::smoothstep(0.0, 2.0, below);
+    // The collar's edge against the neck, over edge_mm: the rows there are
+    // a few mm apart and get the texture of two rows each (face.json
+    // resolution.bust), so it stays a crisp line.
+    const double cover = glm::smoothstep(0.0, sh.edge_mm, below);
     *gloss = mix(*gloss, 1.0, cover);
     return blend(c * (1.0 - sh.neck_shade), cloth, cover);
 }
