@@ -552,7 +552,9 @@ Texel Painter::skin(glm::dvec3 q) const {
         const glm::dvec3 b = glm::dvec3{q.x, q.y, 0.35 * q.z} / al.blotch_size;
         const double red = glm::smoothstep(0.5, 0.78, fbm(b.x + 3.1, b.y, b.z + 51.0));
         const double brown = glm::smoothstep(0.55, 0.8, fbm(0.7 * b.x, 0.7 * b.y + 5.3, 0.7 * b.z + 57.0));
-        c = redden_hue(c, al.blotch_strength * red);
+        // The forehead is the least red site (HAN): its blotches are
+        // fainter (evenly spread red patches over it read as a rash).
+        c = redden_hue(c, al.blotch_strength * red * (1.0 - 0.6 * glm::smoothstep(12.0, 35.0, q.y)));
         c = blend(c, c * Rgb{0.95, 0.92, 0.88}, al.blotch_strength * brown);
     }
     // Pore-scale variation: the skin's grain lightens and darkens it at
