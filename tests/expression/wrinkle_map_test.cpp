@@ -723,6 +723,45 @@ TEST(FoldShape, ParallelFoldsDiffer) {
         }
 }
 
+// ---------------------------------------------------------------- the shipped folds
+
+// A frown is bunched skin more than a line (issue 11, session 8: the glabella
+// lines read as 'painted strokes'): over the left half of the glabella and
+// the inner brow head, AU4L's skin rises higher than its furrow sinks.
+TEST(ShippedFolds, AFrownIsBunchedSkinMoreThanALine) {
+    const FeatureLayout& layout = key_layout("AU4L");
+    const std::vector<float> height = key_height("AU4L", 512);
+    const float u = layout.face_unit();
+    const glm::vec2 mid = 0.5f * (layout.at("4.1") + layout.at("4.2")), brow = layout.at("4.1");
+    float raised = 0.0f, sunk = 0.0f;
+    for (int r = int((brow.y - 0.16f * u) * 512); r <= int((brow.y + 0.08f * u) * 512); ++r)
+        for (int c = int(mid.x * 512); c <= int((brow.x + 0.08f * u) * 512); ++c) {
+            raised = std::max(raised, height[r * 512 + c]);
+            sunk = std::max(sunk, -height[r * 512 + c]);
+        }
+    std::printf("AU4L over the glabella: raised %.2f, sunk %.2f (face units x 1000)\n", 1000 * raised / u,
+                1000 * sunk / u);
+    ASSERT_GT(sunk, 0.0f) << "no furrow between the brows";
+    EXPECT_GT(raised, 1.2f * sunk) << "the frown's mounds are lower than its furrow is deep";
+}
+
+// Crow's feet run 1-2 cm out to the temple (issue 11, session 8: 'barely
+// visible'; they faded out within ~1 cm): a quarter of a face unit out from
+// the outer eye corner AU6L still folds at a third of its deepest.
+TEST(ShippedFolds, CrowsFeetReachTowardsTheTemple) {
+    const FeatureLayout& layout = key_layout("AU6L");
+    const std::vector<float> height = key_height("AU6L", 512);
+    const float u = layout.face_unit();
+    const glm::vec2 corner = layout.at("3.7");
+    const int r0 = int((corner.y - 0.12f * u) * 512), r1 = int((corner.y + 0.12f * u) * 512);
+    const auto depth_out = [&](float out) { return floor_depth(height, int((corner.x + out * u) * 512), r0, r1); };
+    float deepest = 0.0f;
+    for (float out = 0.08f; out <= 0.2f; out += 0.01f) deepest = std::max(deepest, depth_out(out));
+    std::printf("AU6L crow's feet: deepest %.5f, at 0.25 out %.5f\n", deepest, depth_out(0.25f));
+    ASSERT_GT(deepest, 0.0f);
+    EXPECT_GT(depth_out(0.25f), deepest / 3.0f) << "the crow's feet stop close to the eye corner";
+}
+
 // The cavity says how enclosed a valley is: a narrow crease is darker at
 // its floor than a broad fold of the same depth (which lies open in its
 // own wide walls), so fine lines read as creases and broad folds as soft
