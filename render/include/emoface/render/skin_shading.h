@@ -59,7 +59,7 @@ struct RigLight {
 
 // The procedural pore map: a square tile of `size` texels holding a
 // jittered grid of `cells` x `cells` pits (a cell of `cells`-th of the tile)
-// over a fine value noise.
+// over the skin's microrelief, crossing families of meandering furrows.
 struct PoreMapSpec {
     int size = 256;
     int cells = 28;
