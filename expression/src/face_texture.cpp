@@ -689,9 +689,11 @@ Texel Painter::skin(glm::dvec3 q) const {
             // shade there the lip read as a roll laid on a flat chin.
             {
                 const double under = lo - q.y;
-                const double band = glm::smoothstep(-0.5, 1.5, under) * (1.0 - glm::smoothstep(3.0, 8.0, under));
+                // Starting a little below the border: begun at it, the
+                // shade drew an outline along the lower lip.
+                const double band = glm::smoothstep(0.5, 3.5, under) * (1.0 - glm::smoothstep(4.5, 9.0, under));
                 const double across = 1.0 - glm::smoothstep(0.45 * hw, 0.95 * hw, ax);
-                c = blend(c, c * Rgb{0.8, 0.74, 0.72}, 0.55 * band * across);
+                c = blend(c, c * Rgb{0.8, 0.74, 0.72}, 0.5 * band * across);
             }
             const double wander = 0.35 * (noise(q.x * 0.6, q.y * 0.6, 3.0) - 0.5);
             const double inside = std::min({up - q.y, q.y - lo, (hw - ax) * 0.6}) + wander;
