@@ -72,11 +72,13 @@ double radius_factor(std::string_view id) {
 // smile (AU6 pushing from above, AU12 pulling the mouth corner up towards
 // the cheekbone) bunches up and forward, lateral to the nasolabial fold,
 // which it deepens. Its rise is the cheek point's rise plus kCornerShare of
-// the mouth corner's; it moves by kMassUp of that up, kMassForward forward
+// the mouth corner's and kUpperLipShare of the upper lip's outer point's (AU10:
+// the levator labii lifts the infraorbital triangle with the lip and deepens
+// the fold's upper part); it moves by kMassUp of that up, kMassForward forward
 // and kMassOut out (kMassUp < 0: see below), most at its centre, nothing medial to the fold.
 // Observers saw a smile that "moves only the mouth" when the cheek only slid
 // up with the skin (issue 11); a Duchenne cheek comes 3-5 mm forward.
-constexpr double kCornerShare = 1.2;
+constexpr double kCornerShare = 1.2, kUpperLipShare = 1.0;
 // The sheet already carries the mass up with the cheek point; held back by a
 // tenth of its rise, it does not crowd the skin under the lower lid further
 // (which creased it past the smoothness bound).
@@ -390,7 +392,7 @@ void FaceRig::build_point_field(const Face& face, double radius_scale) {
     auto add_entry = [&](int fp, Driven kind) {
         lid_fps_.push_back(fp);
         lid_kind_.push_back(kind);
-        cheek_mass_.push_back({-1, 0.0});
+        cheek_mass_.push_back({-1, -1, 0.0});
         return static_cast<int>(lid_fps_.size()) - 1;
     };
     constexpr double kBrowShield = 0.9;
@@ -481,7 +483,8 @@ void FaceRig::build_cheek_masses(detail::GeodesicGraph& graph, double es) {
         return p.present && p.vertex >= 0;
     };
     auto at = [&](const char* id) { return to_v(fps_[fap::feature_point_index(id)].position); };
-    for (const auto& [cheek_id, corner_id, wing_id] : {std::array{"5.3", "8.3", "9.1"}, std::array{"5.4", "8.4", "9.2"}}) {
+    for (const auto& [cheek_id, corner_id, wing_id, lip_id] :
+         {std::array{"5.3", "8.3", "9.1", "8.5"}, std::array{"5.4", "8.4", "9.2", "8.6"}}) {
         if (!located(cheek_id) || !located(corner_id) || !located(wing_id)) continue;
         const V cheek = at(cheek_id), corner = at(corner_id), wing = at(wing_id);
         const double out = cheek[0] > wing[0] ? 1.0 : -1.0;
@@ -528,7 +531,7 @@ void FaceRig::build_cheek_masses(detail::GeodesicGraph& graph, double es) {
         const int entry = static_cast<int>(lid_fps_.size());
         lid_fps_.push_back(fap::feature_point_index(cheek_id));
         lid_kind_.push_back(Driven::CheekMass);
-        cheek_mass_.push_back({fap::feature_point_index(corner_id), out});
+        cheek_mass_.push_back({fap::feature_point_index(corner_id), located(lip_id) ? fap::feature_point_index(lip_id) : -1, out});
         const double radius = kMassRadius * es;
         // Straight-line distance: the graph's edge-path distance zigzags at
         // the mass's scale and creased its top. The search runs kMassSearch
@@ -807,7 +810,8 @@ std::array<double, 3> FaceRig::lid_displacement(std::size_t i,
     case Driven::LidBulge: return {0.0, 0.0, std::max(fp[1], 0.0)};  // a lower margin's rise, forward
     case Driven::CheekMass: {
         const CheekMass& m = cheek_mass_[i];
-        const double rise = std::max(fp[1], 0.0) + kCornerShare * std::max(fp_d[m.corner][1], 0.0);
+        const double rise = std::max(fp[1], 0.0) + kCornerShare * std::max(fp_d[m.corner][1], 0.0) +
+                            (m.lip >= 0 ? kUpperLipShare * std::max(fp_d[m.lip][1], 0.0) : 0.0);
         return {kMassOut * m.out * rise, kMassUp * rise, kMassForward * rise};
     }
     }

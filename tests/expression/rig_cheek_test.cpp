@@ -75,6 +75,11 @@ TEST(RigCheek, ASmileBringsTheCheekForwardAndUpBesideADeeperFold) {
         {"joy", profiles()[Emotion::Joy], 3.0, 6.5, 2.0},
         {"AU6 cheek raiser", au(6), 2.0, 5.0, 1.5},
         {"AU12 lip corner puller", au(12), 1.0, 4.0, 0.5},
+        // Disgust's nose wrinkler and the upper lip raiser lift it a little
+        // (the infraorbital triangle goes up with the lip).
+        {"disgust", profiles()[Emotion::Disgust], 0.7, 2.5, 0.5},
+        {"AU9 nose wrinkler", au(9), 0.7, 2.5, 0.5},
+        {"AU10 upper lip raiser", au(10), 0.5, 2.0, 0.3},
         // Nothing lifts the cheek or the corners: it stays.
         {"AU15 lip corner depressor", au(15), -0.3, 0.3, -1.0},
         {"AU20 lip stretcher", au(20), -0.3, 0.3, -1.0},
@@ -154,6 +159,9 @@ TEST(RigCheek, TheSmilingCheekHasNoRidgeDownIt) {
         {"AU6 cheek raiser", au(6)},
         {"AU12 lip corner puller", au(12)},
         {"AU6+AU12", au6_12},
+        {"disgust", profiles()[Emotion::Disgust]},
+        {"AU9", au(9)},
+        {"AU10", au(10)},
     };
     // Between triangles of about 2.5 mm (the half-resolution test face) the
     // mound bends each edge by up to about 7 degrees; the ridge along the

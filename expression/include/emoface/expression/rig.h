@@ -189,10 +189,12 @@ private:
     };
     std::vector<int> lid_fps_;
     std::vector<Driven> lid_kind_;
-    // Per CheekMass entry: the mouth corner whose rise bunches it, and which
-    // way is out (+1 on the face's left).
+    // Per CheekMass entry: the mouth corner and the upper lip's outer point
+    // (-1 when absent) whose rise bunches it, and which way is out (+1 on
+    // the face's left).
     struct CheekMass {
         int corner;
+        int lip;
         double out;
     };
     std::vector<CheekMass> cheek_mass_;  // indexed like lid_fps_ (unused but for CheekMass entries)
