@@ -232,6 +232,44 @@ TEST(DefaultFace, NoseBridgeIsARoundedRidge) {
     EXPECT_LT(worst, 80.0f) << "a crease runs down the nasal dorsum";
 }
 
+// The jaw line is clean (blind review, session 8: "bulges at the jaw
+// corners, the lower face looks swollen"): seen from the front, the face's
+// outline narrows steadily from the mouth corners down to the chin. The
+// midface's egg rounded in towards the chin while the mandible's end stood
+// out at each angle, so the outline widened again by 0.4 mm below y -76 (a
+// lump at each jaw angle); the jaw part fills the cheek plane down to it.
+TEST(DefaultFace, FrontalOutlineNarrowsFromTheMouthToTheChin) {
+    const Face& f = test_face();
+    const double top = f.position(fp("8.3"))[1], bottom = f.position(fp("2.1"))[1] + 8.0;
+    // Widest skin where the plane y crosses the mesh's edges, in front of
+    // the neck's back (z > -15), on either side.
+    auto half_width = [&](double y) {
+        double w = 0;
+        for (auto eh : f.mesh.edges()) {
+            const auto h = f.mesh.halfedge_handle(eh, 0);
+            const int a = f.mesh.from_vertex_handle(h).idx(), b = f.mesh.to_vertex_handle(h).idx();
+            if (f.parts[a] != VertexPart::Skin || f.parts[b] != VertexPart::Skin) continue;
+            const auto pa = f.mesh.point(TriMesh::VertexHandle(a)), pb = f.mesh.point(TriMesh::VertexHandle(b));
+            if ((pa[1] - y) * (pb[1] - y) >= 0) continue;
+            const double t = (y - pa[1]) / (pb[1] - pa[1]);
+            if (pa[2] + t * (pb[2] - pa[2]) < -15.0) continue;
+            w = std::max(w, std::abs(pa[0] + t * (pb[0] - pa[0])));
+        }
+        return w;
+    };
+    double narrowest = 1e9, regrowth = 0, at = 0;
+    for (double y = top; y > bottom; y -= 2.0) {
+        const double w = half_width(y);
+        narrowest = std::min(narrowest, w);
+        if (w - narrowest > regrowth) {
+            regrowth = w - narrowest;
+            at = y;
+        }
+    }
+    EXPECT_LT(narrowest, 60.0);
+    EXPECT_LT(regrowth, 0.2) << "the outline widens again at y " << at << ": a lump at the jaw angle";
+}
+
 TEST(DefaultFace, EyeballsSitUnderOpenLidsAndPartsAreContiguous) {
     const Face& f = test_face();
     ASSERT_EQ(f.eyeballs.size(), 2u);
