@@ -270,6 +270,46 @@ TEST(DefaultFace, FrontalOutlineNarrowsFromTheMouthToTheChin) {
     EXPECT_LT(regrowth, 0.2) << "the outline widens again at y " << at << ": a lump at the jaw angle";
 }
 
+// The nose starts in a dip under the glabella and is about as long as the
+// ear (FIDELITY.md 4: nasion to subnasale about 50 mm). Without the dip (0.8
+// mm deep in session 7) the forehead ran straight into the dorsum and the
+// nose read as long, starting between the brows (blind review, session 8).
+TEST(DefaultFace, NoseRootSitsInADipUnderTheGlabella) {
+    const Face& f = test_face();
+    // The midline's profile: the most forward skin within 0.8 mm of x = 0
+    // and 1.5 mm of y (the test face's rows are up to 3 mm apart).
+    auto profile_z = [&](double y) {
+        double z = -1e9;
+        for (int v = 0; v < f.vertex_count(); ++v) {
+            if (f.parts[v] != VertexPart::Skin) continue;
+            const auto q = f.mesh.point(TriMesh::VertexHandle(v));
+            if (q[2] > 0.0f && std::abs(q[0]) < 0.8 && std::abs(q[1] - y) < 1.5) z = std::max(z, double(q[2]));
+        }
+        return z;
+    };
+    const double brow_y = f.position(fp("4.1"))[1], tip_y = f.position(fp("9.3"))[1];
+    const double mouth_y = f.position(fp("8.1"))[1];
+    // The nasion: the deepest point of the profile between the brows and
+    // halfway to the tip; the glabella: the most forward point above it.
+    double nasion_y = brow_y, nasion_z = 1e9, glabella_z = -1e9;
+    for (double y = brow_y; y > 0.5 * (brow_y + tip_y); y -= 1.0) {
+        const double z = profile_z(y);
+        if (z < nasion_z) nasion_z = z, nasion_y = y;
+    }
+    for (double y = nasion_y; y < nasion_y + 15.0; y += 1.0) glabella_z = std::max(glabella_z, profile_z(y));
+    EXPECT_GT(glabella_z - nasion_z, 2.0) << "no frontonasal dip: the forehead runs straight into the nose";
+    // Subnasale: going down from the tip, where the columella's underside
+    // (falling back over 1 mm a mm) turns into the upper lip.
+    double subnasale_y = mouth_y;
+    for (double y = tip_y - 3.0; y > mouth_y; y -= 1.0)
+        if (profile_z(y) - profile_z(y - 1.0) < 1.0) {
+            subnasale_y = y;
+            break;
+        }
+    EXPECT_GT(nasion_y - subnasale_y, 45.0) << "nasion " << nasion_y << ", subnasale " << subnasale_y;
+    EXPECT_LT(nasion_y - subnasale_y, 58.0) << "nasion " << nasion_y << ", subnasale " << subnasale_y;
+}
+
 TEST(DefaultFace, EyeballsSitUnderOpenLidsAndPartsAreContiguous) {
     const Face& f = test_face();
     ASSERT_EQ(f.eyeballs.size(), 2u);
