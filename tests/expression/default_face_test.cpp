@@ -523,7 +523,7 @@ TEST_F(BadFaceParams, MessagesNameTheFileAndKey) {
                                 "lower_lid_peak, lid_clearance, lid_thickness, lid_blend_inner, lid_blend_outer, "
                                 "lid_warp_reach, sclera_corner_tint, sclera_vessels, lid_shadow, upper_lashes, lower_lashes), found \"radiuss\""},
         {replaced("\"iris_radius\": 5.9,", ""), "expression: " + file + ": eyes.iris_radius: expected a value, found no such key"},
-        {replaced("\"centre_y\": -66,", "\"centre_y\": \"low\","),
+        {replaced("\"centre_y\": -69,", "\"centre_y\": \"low\","),
          "expression: " + file + ": mouth.centre_y: expected a number, found \"low\""},
         {replaced("\"texture_size\": 2048", "\"texture_size\": 9"),
          "expression: " + file + ": resolution.texture_size: expected an integer in [16, 8192], found 9"},
