@@ -238,7 +238,7 @@ std::vector<Row> Generator::resample(const std::vector<detail::RowKey>& keys) co
 glm::dvec3 Generator::bust_point(double theta, double share) const {
     const double c = std::cos(theta);
     const glm::dvec3& len = p_.bust_length_mm;
-    const double length = len[1] + ((c >= 0 ? len[0] : len[2]) - len[1]) * std::sqrt(std::abs(c));
+    const double length = len[1] + ((c >= 0 ? len[0] : len[2]) - len[1]) * std::abs(c);
     auto it = bust_profiles_.find(theta);
     if (it == bust_profiles_.end()) {
         const glm::dvec3 o = lowest_ray_row_.origin(theta);
@@ -450,25 +450,15 @@ void Generator::build_skin(Face& face) {
         return d;
     };
     // Each row gap takes the same height of texture, but the bust's (a
-    // few mm to a few cm apart) take bust.texture_rows in all, each in
-    // inverse proportion to its spacing: most where the rows are closest,
-    // round the collar, whose edge one texture row per 5 mm (one per row
-    // gap) blurred across the rows at the mip level the columns' denser u
-    // picks; least out on the shoulders, plain cloth.
+    // few mm to a few cm apart) take bust.texture_rows / bust.rows as much:
+    // with one each, the collar's edge blurred across its rows at the mip
+    // level that the columns' denser u picks, and the shader's pores
+    // (tiled in the base UVs) stretched down the chest into streaks. (More
+    // where the rows are closest, round the collar, left the outer rows a
+    // texel per 2-3 mm: streaks again.)
     std::vector<double> below(static_cast<std::size_t>(nrows), 0.0);
-    {
-        const double a = p_.bust_first_share;
-        auto share = [&](double u) { return a * u + (1.0 - a) * u * u; };
-        std::vector<double> w(static_cast<std::size_t>(bust_rows_));
-        double sum = 0.0;
-        for (int j = 0; j < bust_rows_; ++j) {
-            const int k = bust_rows_ - 1 - j;  // gaps counted from the neck
-            w[j] = 1.0 / (share(static_cast<double>(k + 1) / bust_rows_) - share(static_cast<double>(k) / bust_rows_));
-            sum += w[j];
-        }
-        const double total = p_.bust_rows > 0 ? p_.bust_texture_rows * bust_rows_ / p_.bust_rows : 0.0;
-        for (int j = 1; j < nrows; ++j) below[j] = below[j - 1] + (j - 1 < bust_rows_ ? total * w[j - 1] / sum : 1.0);
-    }
+    const double bust_gap = p_.bust_rows > 0 ? p_.bust_texture_rows / p_.bust_rows : 1.0;
+    for (int j = 1; j < nrows; ++j) below[j] = below[j - 1] + (j - 1 < bust_rows_ ? bust_gap : 1.0);
     auto v_of = [&](int j) { return detail::kSkinV0 + (0.995 - detail::kSkinV0) * below[j] / below.back(); };
 
     for (int j = 0; j < nrows; ++j) {

@@ -871,11 +871,11 @@ Rgb Painter::shirt(glm::dvec3 q, Rgb c, double* gloss) const {
     const double fold = std::sin(sh.fold_count * 2.0 * fan + wander + (q.x < 0 ? 0.7 : 0.0));
     const double fold_reach = glm::smoothstep(0.0, 12.0, below) * (1.0 - 0.6 * glm::smoothstep(40.0, 120.0, below));
     // The wales follow the columns (about 80 mm of arc per radian of
-    // azimuth round the body), so the texture's coarser rows on the
-    // shoulders cannot alias them; they fade out there, where they would be
-    // a few mm apart.
+    // azimuth round the body) and fade out on the shoulders, where they
+    // would be a few mm apart, and down the chest, where the bust's rows get
+    // a texel or less a mm: stretched along those rows they drew streaks.
     const double weave = std::cos(2.0 * kPi * 80.0 * std::atan2(q.x, q.z + 30.0) / sh.weave_mm) *
-                         (1.0 - glm::smoothstep(70.0, 110.0, ax));
+                         (1.0 - glm::smoothstep(70.0, 110.0, ax)) * (1.0 - glm::smoothstep(20.0, 35.0, below));
     cloth = cloth * (1.0 + 2.0 * sh.mottling * broad + sh.folds * fold * fold_reach + sh.weave * weave);
     // The collar: a ribbed band below the neckline, its ribs across it, its
     // folded top edge rounded (lighter where it turns up to the light, a
