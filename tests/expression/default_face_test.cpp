@@ -204,6 +204,30 @@ TEST(DefaultFace, NeckIsSmoothAcrossTheMidline) {
     EXPECT_LT(worst, 0.12f) << "a crease runs down the base of the throat at x = 0";
 }
 
+// The bust is a portrait's (face.json resolution.bust, head.shoulders): the
+// shoulders slope down from the neck and out past the default frame's sides
+// (about 190 mm out at z 0), above its bottom (about -205 mm), on both
+// sides. Rays cast from the neck's axis grazed the slope and ended in a flat
+// disc about 165 mm out (blind review, session 8).
+TEST(DefaultFace, ShouldersSlopeOutPastTheFramesSides) {
+    const Face& f = test_face();
+    float left = 0.0f, right = 0.0f, top_near = -1e9f, top_far = -1e9f;
+    for (int v = 0; v < f.vertex_count(); ++v) {
+        if (f.parts[v] != VertexPart::Skin) continue;
+        const auto q = f.mesh.point(TriMesh::VertexHandle(v));
+        if (q[1] < -205.0f || q[1] > -120.0f) continue;
+        left = std::max(left, q[0]);
+        right = std::max(right, -q[0]);
+        const float ax = std::abs(q[0]);
+        if (ax > 60.0f && ax < 100.0f) top_near = std::max(top_near, q[1]);
+        if (ax > 130.0f && ax < 190.0f) top_far = std::max(top_far, q[1]);
+    }
+    EXPECT_GT(left, 195.0f);
+    EXPECT_GT(right, 195.0f);
+    EXPECT_LT(top_far, top_near - 12.0f) << "the shoulders' top slopes down away from the neck";
+    EXPECT_GT(top_far, -200.0f) << "and stays inside the frame";
+}
+
 // The nasal dorsum is a rounded ridge (face.json's nose "apex_round"): with
 // a pointed crest (about 1 mm radius) the bridge shaded as a seam down the
 // midline. Across the dorsum, between the nasion and the tip, neighbouring
