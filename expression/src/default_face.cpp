@@ -450,15 +450,28 @@ void Generator::build_skin(Face& face) {
         return d;
     };
     // Each row gap takes the same height of texture, but the bust's (a
-    // few mm to a few cm apart) take bust.texture_rows / bust.rows as much:
-    // with one each, the collar's edge blurred across its rows at the mip
-    // level that the columns' denser u picks, and the shader's pores
-    // (tiled in the base UVs) stretched down the chest into streaks. (More
-    // where the rows are closest, round the collar, left the outer rows a
-    // texel per 2-3 mm: streaks again.)
+    // few mm to a few cm apart) take bust.texture_rows in all, each in
+    // inverse proportion to the square root of its spacing: more where the
+    // rows are closest, round the collar, whose edge one texture row per
+    // gap blurred across the rows at the mip level that the columns' denser
+    // u picks; enough on the outer rows that the shader's pores (tiled in
+    // the base UVs) do not stretch down the chest into streaks, as they did
+    // at inverse proportion to the spacing itself.
     std::vector<double> below(static_cast<std::size_t>(nrows), 0.0);
-    const double bust_gap = p_.bust_rows > 0 ? p_.bust_texture_rows / p_.bust_rows : 1.0;
-    for (int j = 1; j < nrows; ++j) below[j] = below[j - 1] + (j - 1 < bust_rows_ ? bust_gap : 1.0);
+    {
+        const double a = p_.bust_first_share;
+        auto share = [&](double u) { return a * u + (1.0 - a) * u * u; };
+        std::vector<double> w(static_cast<std::size_t>(bust_rows_));
+        double sum = 0.0;
+        for (int j = 0; j < bust_rows_; ++j) {
+            const int k = bust_rows_ - 1 - j;  // gaps counted from the neck
+            const double spacing = share(static_cast<double>(k + 1) / bust_rows_) - share(static_cast<double>(k) / bust_rows_);
+            w[j] = 1.0 / std::sqrt(spacing);
+            sum += w[j];
+        }
+        const double total = p_.bust_rows > 0 ? p_.bust_texture_rows * bust_rows_ / p_.bust_rows : 0.0;
+        for (int j = 1; j < nrows; ++j) below[j] = below[j - 1] + (j - 1 < bust_rows_ ? total * w[j - 1] / sum : 1.0);
+    }
     auto v_of = [&](int j) { return detail::kSkinV0 + (0.995 - detail::kSkinV0) * below[j] / below.back(); };
 
     for (int j = 0; j < nrows; ++j) {
