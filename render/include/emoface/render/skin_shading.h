@@ -151,8 +151,8 @@ struct SkinShading {
     // --- light rig (the key light is the draw's Light, tinted) ---
     glm::vec3 key_tint{1.06f, 0.98f, 0.88f};
     float softness = 0.1f;  // wrap of every rig light's N.L (soft boxes), energy kept
-    RigLight fill{{0.7f, 0.1f, 0.7f}, {0.14f, 0.16f, 0.2f}};
-    RigLight rim{{0.5f, 0.6f, -0.65f}, {0.36f, 0.34f, 0.31f}};
+    RigLight fill{{0.5f, 0.1f, 0.86f}, {0.16f, 0.18f, 0.22f}};
+    RigLight rim{{0.5f, 0.6f, -0.65f}, {0.2f, 0.19f, 0.17f}};
     glm::vec3 sky{0.14f, 0.155f, 0.18f};      // ambient from above (+y)
     glm::vec3 ground{0.08f, 0.06f, 0.05f};  // ambient from below (warm bounce)
     float exposure = 0.85f;
