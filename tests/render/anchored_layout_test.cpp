@@ -414,21 +414,23 @@ TEST_F(AnchoredLayout, PaintedGroovesShadeAsValleys) {
                            glm::vec2(0.0f, 0.6f * glm::distance(in_l, in_r));
     const glm::vec2 at = screen_of_painted(spot);
     // Rows of (with - without) across the groove, averaged over 21 columns.
-    // Lit from above, a valley is darker above its line and lighter below:
-    // the first moment of the change about the line is positive (y down); a
-    // ridge (green read upwards) makes it negative. The grooves lie about
-    // 10 pixels apart on screen, so the window stays within this one.
-    double moment = 0, darkest = 0;
-    int darkest_row = 0;
-    for (int dy = -4; dy <= 4; ++dy) {
-        const int x = int(at.x), y = int(at.y) + dy;
-        const double d = signed_diff(with, without, x - 10, y, x + 10, y);
-        moment += dy * d;
-        if (d < darkest) darkest = d, darkest_row = dy;
-    }
-    std::printf("forehead groove at (%.1f, %.1f): first moment %+.1f, darkest row %+d (%+.1f)\n", at.x, at.y,
-                moment, darkest_row, darkest);
-    EXPECT_GT(moment, 20.0);
+    // The groove's floor is its darkest row (its cavity darkens it under any
+    // light), within 4 rows of where it was painted (the grooves lie about
+    // 6 pixels apart on screen, so that stays with this one). Lit from above,
+    // a valley's upper wall faces down and darkens more than its lower wall:
+    // the first moment of the change about the floor (y down) is positive; a
+    // ridge (green read upwards) darkens below its crest and makes it negative.
+    const int x = int(at.x);
+    auto row_change = [&](int y) { return signed_diff(with, without, x - 10, y, x + 10, y); };
+    int floor_row = int(at.y);
+    for (int y = int(at.y) - 4; y <= int(at.y) + 4; ++y)
+        if (row_change(y) < row_change(floor_row)) floor_row = y;
+    double moment = 0;
+    for (int dy = -2; dy <= 2; ++dy) moment += dy * row_change(floor_row + dy);
+    const double darkest = row_change(floor_row);
+    std::printf("forehead groove painted at (%.1f, %.1f): floor at row %+d (%+.1f), first moment about it %+.1f\n",
+                at.x, at.y, floor_row - int(at.y), darkest, moment);
+    EXPECT_GT(moment, 10.0);
     EXPECT_LT(darkest, -3.0);
 }
 
