@@ -128,7 +128,8 @@ GLuint link_program(const char* vs_source, const char* fs_source) {
 }
 
 // A 2D texture from `texels` (rows first row first, as GL reads them),
-// clamped or repeating, bilinear, with mipmaps when asked.
+// clamped or repeating, bilinear, with mipmaps and anisotropic filtering
+// (where the driver has it) when asked.
 struct TextureUpload {
     GLint internal_format;
     GLenum format, type;
@@ -136,6 +137,7 @@ struct TextureUpload {
     bool mipmaps;
     GLint wrap;
     const char* what;  // for the GL error check
+    float anisotropy = 1.0f;  // the most texels along a pixel's long axis; 1: trilinear
 };
 GLuint upload_texture(const TextureUpload& u, int width, int height, const void* texels) {
     GLuint t = 0;
@@ -146,6 +148,8 @@ GLuint upload_texture(const TextureUpload& u, int width, int height, const void*
     glTexImage2D(GL_TEXTURE_2D, 0, u.internal_format, width, height, 0, u.format, u.type, texels);
     if (u.mipmaps) glGenerateMipmap(GL_TEXTURE_2D);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, u.mipmaps ? GL_LINEAR_MIPMAP_LINEAR : GL_LINEAR);
+    if (u.anisotropy > 1.0f && epoxy_has_gl_extension("GL_EXT_texture_filter_anisotropic"))
+        glTexParameterf(GL_TEXTURE_2D, GL_TEXTURE_MAX_ANISOTROPY_EXT, u.anisotropy);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, u.wrap);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, u.wrap);
@@ -153,6 +157,11 @@ GLuint upload_texture(const TextureUpload& u, int width, int height, const void*
     check_gl(u.what);
     return t;
 }
+
+// 2x already removes the shirt's stripe; the H100's draw is 2.872 ms with it,
+// 2.897 with 4x and 3.34 with 8x on every mipmapped map (the bound is 2.9;
+// docs/PERFORMANCE.md, session 8).
+constexpr float kBaseMapAnisotropy = 2.0f;
 
 GLuint upload_srgb_texture(const ImageRGBA8& image) {
     if (image.width <= 0 || image.height <= 0 ||
@@ -166,8 +175,11 @@ GLuint upload_srgb_texture(const ImageRGBA8& image) {
     for (int y = 0; y < image.height; ++y)
         std::copy_n(image.pixels.data() + std::size_t(image.height - 1 - y) * row, row,
                     flipped.data() + std::size_t(y) * row);
+    // Anisotropic: the atlas squeezes the bust's rows into few texture rows,
+    // so a trilinear lookup there took a mip level as coarse as the rows' v
+    // rate and smeared the neck's skin down the shirt's front as a stripe.
     return upload_texture({GL_SRGB8_ALPHA8, GL_RGBA, GL_UNSIGNED_BYTE, 1, true, GL_CLAMP_TO_EDGE,
-                           "uploading a base texture"},
+                           "uploading a base texture", kBaseMapAnisotropy},
                           image.width, image.height, flipped.data());
 }
 
