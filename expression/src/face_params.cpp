@@ -57,6 +57,18 @@ Bump read_bump(JsonReader b) {
 
 glm::dvec3 colour(JsonReader& r, const std::string& key) { return to_glm(r.numbers<3>(key)); }
 
+// A Gaussian patch of the face's albedo (a flush, a pore region): where, how
+// wide, and how much, its amount in [min_amount, max_amount].
+FaceParams::Flush read_patch(JsonReader& r, double min_amount, double max_amount) {
+    FaceParams::Flush patch;
+    patch.centre = to_glm(r.numbers<2>("centre"));
+    patch.size = to_glm(r.numbers<2>("size"));
+    if (!(patch.size[0] > 0 && patch.size[1] > 0)) r.at("size").fail("two widths > 0 (mm)");
+    patch.amount = r.number_in("amount", min_amount, max_amount);
+    r.finish();
+    return patch;
+}
+
 }  // namespace
 
 FaceParams read_face_params(const std::string& params_dir) {
@@ -336,15 +348,7 @@ FaceParams read_face_params(const std::string& params_dir) {
             auto& a = p.albedo;
             a.pigment_variation = r.number_in("pigment_variation", 0.0, 0.5);
             a.mottling = r.number_in("mottling", 0.0, 2.0);
-            for (JsonReader& f : r.objects("flush")) {
-                FaceParams::Flush fl;
-                fl.centre = to_glm(f.numbers<2>("centre"));
-                fl.size = to_glm(f.numbers<2>("size"));
-                if (!(fl.size[0] > 0 && fl.size[1] > 0)) f.at("size").fail("two widths > 0 (mm)");
-                fl.amount = f.number_in("amount", 0.0, 1.5);
-                f.finish();
-                a.flush.push_back(fl);
-            }
+            for (JsonReader& f : r.objects("flush")) a.flush.push_back(read_patch(f, 0.0, 1.5));
             for (JsonReader& t : r.objects("tones")) {
                 FaceParams::Tone tone;
                 tone.centre = to_glm(t.numbers<2>("centre"));
@@ -381,15 +385,7 @@ FaceParams read_face_params(const std::string& params_dir) {
                 if (pores.size > pores.spacing) g.at("size_mm").fail("at most spacing_mm (mm)");
                 pores.strength = g.number_in("strength", 0.0, 0.5);
                 pores.base = g.number_in("base", 0.0, 1.0);
-                for (JsonReader& f : g.objects("regions")) {
-                    FaceParams::Flush region;
-                    region.centre = to_glm(f.numbers<2>("centre"));
-                    region.size = to_glm(f.numbers<2>("size"));
-                    if (!(region.size[0] > 0 && region.size[1] > 0)) f.at("size").fail("two widths > 0 (mm)");
-                    region.amount = f.number_in("amount", -1.0, 1.0);
-                    f.finish();
-                    pores.regions.push_back(region);
-                }
+                for (JsonReader& f : g.objects("regions")) pores.regions.push_back(read_patch(f, -1.0, 1.0));
                 JsonReader grain = g.object("grain");
                 pores.grain_size = grain.number_in("size_mm", 0.1, 5.0);
                 pores.grain_strength = grain.number_in("strength", 0.0, 0.3);
