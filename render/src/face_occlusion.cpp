@@ -44,32 +44,43 @@ std::vector<char> strand_triangles(const std::vector<unsigned>& triangles, std::
     return strand;
 }
 
-// How far the skin at `p` is the upper lid's (from its margin up to the
-// brow, the inner canthus beside it included; 0..1, fading out past the eye's
-// corners and behind the eyeball's centre). `margin` is the upper margin's
-// rest polyline, `brow` the brow's inner, top and outer points.
-float upper_lid_weight(const glm::vec3& p, const std::vector<glm::vec3>& margin, const glm::vec3 (&brow)[3],
-                       const glm::vec3& centre) {
-    const glm::vec3 inner = margin.front(), outer = margin.back();
+// Piecewise linear height (y) at `x` along a polyline ordered inner corner
+// to outer, held flat past its ends.
+float height_along(float x, const std::vector<glm::vec3>& line) {
+    const float sign = line.back().x > line.front().x ? 1.0f : -1.0f;
+    if (sign * (x - line.front().x) <= 0.0f) return line.front().y;
+    for (std::size_t i = 1; i < line.size(); ++i)
+        if (sign * (x - line[i].x) <= 0.0f) {
+            const glm::vec3 q0 = line[i - 1], q1 = line[i];
+            return glm::mix(q0.y, q1.y, (x - q0.x) / (q1.x - q0.x));
+        }
+    return line.back().y;
+}
+
+// How far the skin at `p` lies in the eye's surround that the lids and brow
+// move (0..1): the upper lid from its margin up over the brow's underside,
+// and the lower lid from its margin down over the lid's furrow, the inner
+// canthus beside them; fading out past the eye's corners and behind the
+// eyeball's centre. `upper` and `lower` are the margins' rest polylines
+// (inner corner first), `brow` the brow's inner, top and outer points.
+// `lower_part` gets how much of the weight is the lower lid's.
+float orbit_weight(const glm::vec3& p, const std::vector<glm::vec3>& upper, const std::vector<glm::vec3>& lower,
+                   const std::vector<glm::vec3>& brow, const glm::vec3& centre, float& lower_part) {
+    lower_part = 0.0f;
+    const glm::vec3 inner = upper.front(), outer = upper.back();
     const float a = (p.x - inner.x) / (outer.x - inner.x);  // 0 inner corner, 1 outer
-    const float across = glm::smoothstep(-0.35f, -0.05f, a) * (1.0f - glm::smoothstep(1.0f, 1.25f, a));
+    // Nasally the surround reaches under the brow's head, which AU1 and
+    // AU4 move most: a weight ending at the corner left the rest shade of
+    // that corner on the raised brow's underside.
+    const float across = glm::smoothstep(-0.45f, -0.1f, a) * (1.0f - glm::smoothstep(1.0f, 1.25f, a));
     if (across <= 0.0f) return 0.0f;
-    // Piecewise linear in x along a polyline ordered inner to outer.
-    auto height_at = [&](auto&& point, std::size_t count) {
-        const float x = p.x;
-        const float sign = outer.x > inner.x ? 1.0f : -1.0f;
-        if (sign * (x - point(0).x) <= 0.0f) return point(0).y;
-        for (std::size_t i = 1; i < count; ++i)
-            if (sign * (x - point(i).x) <= 0.0f) {
-                const glm::vec3 q0 = point(i - 1), q1 = point(i);
-                return glm::mix(q0.y, q1.y, (x - q0.x) / (q1.x - q0.x));
-            }
-        return point(count - 1).y;
-    };
-    const float lid = height_at([&](std::size_t i) { return margin[i]; }, margin.size());
-    const float top = height_at([&](std::size_t i) { return brow[i]; }, 3);
-    const float up = glm::smoothstep(-1.5f, 0.5f, p.y - lid) * (1.0f - glm::smoothstep(top - 3.0f, top + 2.0f, p.y));
-    return across * up * glm::smoothstep(centre.z - 2.0f, centre.z + 2.0f, p.z);
+    const float lid = height_along(p.x, upper), top = height_along(p.x, brow);
+    const float up = glm::smoothstep(-1.5f, 0.5f, p.y - lid) * (1.0f - glm::smoothstep(top - 1.0f, top + 4.0f, p.y));
+    const float below = height_along(p.x, lower) - p.y;
+    const float down = glm::smoothstep(-0.5f, 0.5f, below) * (1.0f - glm::smoothstep(6.0f, 10.0f, below));
+    const float front = glm::smoothstep(centre.z - 2.0f, centre.z + 2.0f, p.z);
+    lower_part = down / std::max(up + down, 1e-6f);
+    return across * std::min(up + down, 1.0f) * front;
 }
 
 }  // namespace
@@ -137,33 +148,44 @@ std::vector<float> bake_face_occlusion(const expression::TriMesh& mesh, const ex
         return true;
     };
 
-    // The upper lids keep a share of their rest shade. Their skin is the
-    // face's most mobile (AU1, 2 and 5 lift it and the brow by up to 10 mm
-    // and stretch it flat; AU4 and 43 fold it down), while the bake sees it
-    // only at rest, tucked under the brow: carried onto the raised, opened
-    // lid it drew a dark band like eyeshadow over the eyes of fear, surprise
-    // and sadness, where the brow no longer overhangs. A gentle shade stays
-    // (the lid's crease and the brow still shade it a little in every pose);
-    // the lid's shadow on the eyeball is the eye tile's (eye_texture.h).
-    constexpr float kLidShadeKept = 0.25f;
+    // The lids keep a share of their rest shade. Their skin is the face's
+    // most mobile (AU1, 2 and 5 lift the upper lid and the brow by up to
+    // 10 mm and stretch it flat; AU4 and 43 fold it down; AU6 and 7 bunch
+    // the lower lid), while the bake sees it only at rest, tucked under the
+    // brow and in the socket: carried onto the raised, opened lid it drew a
+    // dark band like eyeshadow over the eyes of fear, surprise and sadness,
+    // and round the lower lid's furrow and the inner corner, with the key's
+    // contact shadow (skin.json occlusion) that it drives, a dark smudgy
+    // ring round every eye (blind review, session 9: the bake's share of
+    // it, toggled off, is a ring from the brow's underside round the
+    // furrow under the lower lid). A gentle shade stays (the lid's crease
+    // and the brow still shade it a little in every pose); the lid's
+    // shadow on the eyeball is the eye tile's (eye_texture.h).
+    constexpr float kUpperShadeKept = 0.2f, kLowerShadeKept = 0.4f;
     const char* const brow_ids[2][3] = {{"4.1", "4.3", "4.5"}, {"4.2", "4.4", "4.6"}};
     if (parts_known)
         for (std::size_t side = 0; side < std::min<std::size_t>(face.eyeballs.size(), 2); ++side) {
             const auto& eb = face.eyeballs[side];
-            glm::vec3 brow[3];
-            if (eb.upper_margin.size() < 2 || !point(brow_ids[side][0], brow[0]) ||
+            std::vector<glm::vec3> brow(3);
+            if (eb.upper_margin.size() < 2 || eb.lower_margin.size() < 2 || !point(brow_ids[side][0], brow[0]) ||
                 !point(brow_ids[side][1], brow[1]) || !point(brow_ids[side][2], brow[2]))
                 continue;
-            std::vector<glm::vec3> margin;
-            for (const int v : eb.upper_margin) margin.push_back(positions[std::size_t(v)]);
-            // Inner corner first.
-            if (std::abs(margin.front().x) > std::abs(margin.back().x)) std::reverse(margin.begin(), margin.end());
+            auto polyline = [&](const std::vector<int>& vertices) {
+                std::vector<glm::vec3> line;
+                for (const int v : vertices) line.push_back(positions[std::size_t(v)]);
+                // Inner corner first.
+                if (std::abs(line.front().x) > std::abs(line.back().x)) std::reverse(line.begin(), line.end());
+                return line;
+            };
+            const std::vector<glm::vec3> upper = polyline(eb.upper_margin), lower = polyline(eb.lower_margin);
             const glm::vec3 centre(float(eb.centre[0]), float(eb.centre[1]), float(eb.centre[2]));
             for (std::size_t v = 0; v < n; ++v) {
                 if (face.parts[v] != expression::VertexPart::Skin || (positions[v].x > 0.0f) != (centre.x > 0.0f))
                     continue;
-                const float w = upper_lid_weight(positions[v], margin, brow, centre);
-                if (w > 0.0f) open[v] = glm::mix(open[v], 1.0f - kLidShadeKept * (1.0f - open[v]), w);
+                float lower_part = 0.0f;
+                const float w = orbit_weight(positions[v], upper, lower, brow, centre, lower_part);
+                const float kept = glm::mix(kUpperShadeKept, kLowerShadeKept, lower_part);
+                if (w > 0.0f) open[v] = glm::mix(open[v], 1.0f - kept * (1.0f - open[v]), w);
             }
         }
     glm::vec3 top, bottom, left, right, upper_border, lower_border;

@@ -3,9 +3,11 @@
 // aware that the mouth opens away from it and that the lids move. Three bakes:
 // - the skin, the whole head but the lashes occluding (strands far thinner
 //   than the bake's texel, which it would rasterise as a solid visor over
-//   the lid); the upper lids, from the margin to the brow, keep only a share
-//   of it (their skin moves most of all, out from under the brow when the
-//   brows and lids rise, and carried its rest shade there as a dark band);
+//   the lid); the lids keep only a share of it: the upper lid from its
+//   margin over the brow's underside (its skin moves most of all, out from
+//   under the brow when the brows and lids rise, and carried its rest shade
+//   there as a dark band) and the lower lid over its furrow (its rest
+//   shade, with the key's contact shadow, ringed the eye in a dark smudge);
 // - the lips (around the mouth slit, from the inner lip contour out past the
 //   vermilion borders, found from feature points 2.2-2.5, 8.1 and 8.2): at
 //   rest each lip hides the other's inner face, which would show dark when
