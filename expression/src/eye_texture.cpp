@@ -90,7 +90,7 @@ std::array<double, 3> eye_colour(const FaceShape& shape, double polar, double az
     }
 
     Rgb c = sclera;
-    constexpr double kLimbusSoftness = 0.06;  // radians over which the iris fades into the sclera
+    constexpr double kLimbusSoftness = 0.09;  // radians (about 1.1 mm) over which the iris fades into the sclera
     if (polar < ai + kLimbusSoftness) {
         // Iris: radial fibres over darker gaps that wave a little as they
         // run out, a jagged collarette a third of the way out with the
@@ -122,11 +122,14 @@ std::array<double, 3> eye_colour(const FaceShape& shape, double polar, double az
                                  (1.0 - glm::smoothstep(0.7, 0.8, t)));
         const double furrows = std::pow(0.5 + 0.5 * std::sin(kPi * 2.0 * (t - 0.62) / 0.09 + 0.4 * std::sin(5.0 * azimuth)), 6.0);
         iris = scaled(iris, 1.0 - 0.18 * furrows * glm::smoothstep(0.6, 0.7, t) * (1.0 - glm::smoothstep(0.88, 0.92, t)));
-        // The limbal ring: the stroma darkens over the outer quarter into a
+        // The limbal ring: the stroma darkens over the outer third into a
         // grey-brown band, darkest at the rim (it frames the iris against
-        // the white; a light rim made the iris read small).
-        const double rim = glm::smoothstep(0.72, 1.0, t);
-        iris = blend(iris, tinted(iris, {0.32, 0.31, 0.30}), rim);
+        // the white; a light rim made the iris read small), ramping in over
+        // a third of the iris and fading into the sclera over
+        // kLimbusSoftness: over a quarter, to 0.32, it read at 512 px as a
+        // drawn black outline, a doll's eye (blind review, session 9).
+        const double rim = glm::smoothstep(0.62, 1.0, t);
+        iris = blend(iris, tinted(iris, {0.38, 0.37, 0.36}), rim);
         iris = blend(Rgb{0.10, 0.06, 0.045}, iris, glm::smoothstep(0.02, 0.08, t));  // pupillary ruff
         const Rgb pupil{0.012, 0.011, 0.013};
         iris = blend(pupil, iris, glm::smoothstep(0.0, 0.025, t));
