@@ -758,18 +758,28 @@ Texel Painter::skin(glm::dvec3 q) const {
             const double shell = glm::length(q - centre) - p_.eye_radius;
             const double margin = 1.0 - glm::smoothstep(p_.lid_clearance + 0.35 * p_.lid_thickness,
                                                         p_.lid_clearance + 0.95 * p_.lid_thickness, shell);
+            // The lids' own colour is only a shade off the face's: the
+            // upper lid a little warmer near its margin, the lower lid's
+            // pretarsal strip a little pinker and no darker. Darkened over
+            // 9 and 6 mm, with the lash line, the socket's occlusion and
+            // the albedo's lid tones on top, they drew a dark smudgy ring
+            // round each eye (blind review, session 9).
             if (dy_up > -1.0) {
-                const double lid = (1.0 - glm::smoothstep(0.0, 9.0, dy_up)) * along;
-                c = tint(c, {0.88, 0.8, 0.8}, 0.45 * lid);
-                const double reach = 0.5 + 0.6 * s;  // lash roots thicken towards the outer corner
-                const double lash = (1.0 - glm::smoothstep(0.1, reach, std::abs(dy_up))) * along * (1.0 - margin);
-                c = blend(c, from255(p_.lashes), 0.6 * lash);
+                const double lid = (1.0 - glm::smoothstep(0.0, 5.0, dy_up)) * along;
+                c = tint(c, {0.96, 0.9, 0.9}, 0.35 * lid);
+                // The lash roots: a fine dark line along the margin's front
+                // edge, thicker towards the outer corner, broken where the
+                // lashes grow in clumps (a solid line read as eyeliner).
+                const double reach = 0.35 + 0.4 * s;
+                const double clumps = 0.75 + 0.25 * std::sin(ax * 2.3 + 1.7 * std::sin(ax * 0.9));
+                const double lash = (1.0 - glm::smoothstep(0.05, reach, std::abs(dy_up))) * along * (1.0 - margin);
+                c = blend(c, from255(p_.lashes), 0.5 * clumps * lash);
             }
             if (dy_lo > -1.0) {
-                const double lash = (1.0 - glm::smoothstep(0.05, 0.45, std::abs(dy_lo))) * along * (1.0 - margin);
-                c = blend(c, Rgb{0.3, 0.19, 0.17}, 0.35 * lash);
-                const double shadow = (1.0 - glm::smoothstep(0.0, 6.0, dy_lo)) * along;
-                c = tint(c, {0.9, 0.83, 0.84}, 0.3 * shadow);
+                const double lash = (1.0 - glm::smoothstep(0.05, 0.35, std::abs(dy_lo))) * along * (1.0 - margin);
+                c = blend(c, Rgb{0.36, 0.24, 0.21}, 0.22 * lash);
+                const double pretarsal = (1.0 - glm::smoothstep(0.5, 3.5, dy_lo)) * along * (1.0 - margin);
+                c = tint(c, {1.03, 0.97, 0.97}, 0.5 * pretarsal);
             }
             const double near_slit = 1.0 - glm::smoothstep(1.0, 2.5, std::min(std::abs(dy_up), std::abs(dy_lo)));
             const double strip = margin * near_slit * (within ? 1.0 : along);
@@ -783,7 +793,7 @@ Texel Painter::skin(glm::dvec3 q) const {
                 // band, the eye "pasted in" (blind review, issue 11).
                 const double contact = strip * (1.0 - glm::smoothstep(p_.lid_clearance + 0.15 * p_.lid_thickness,
                                                                       p_.lid_clearance + 0.5 * p_.lid_thickness, shell));
-                c = blend(c, from255(al.lid_margin) * Rgb{0.52, 0.42, 0.42}, 0.75 * contact);
+                c = blend(c, from255(al.lid_margin) * Rgb{0.62, 0.5, 0.5}, 0.6 * contact);
                 gloss = mix(gloss, p_.gloss.tear_line, contact);
                 // The tear meniscus: along the lower margin where it meets the eyeball.
                 const double tear = (1.0 - glm::smoothstep(p_.lid_clearance + 0.1, p_.lid_clearance + 0.6, shell)) *

@@ -281,6 +281,33 @@ TEST(FaceTexture, CheekRednessIsDiffuseNotADisc) {
     EXPECT_LT(ring - centre, 0.035) << "no disc of blush";
 }
 
+// The skin's tone differs by region at the scale a 512 px picture shows
+// (one even tone read as wax to blind observers, session 9): the shaved
+// beard zone is bluer than the cheek (stubble under the skin), the forehead
+// yellower (HAN: the most yellow site). Ratios of the mean colour over a
+// few mm, so pores and blotches average out.
+TEST(FaceTexture, BeardZoneIsBluerAndTheForeheadYellowerThanTheCheek) {
+    const Face& f = painted_face();
+    auto mean = [&](double cx, double cy) {
+        Texel m{0, 0, 0, 0};
+        int n = 0;
+        for (int v = 0; v < f.vertex_count(); ++v) {
+            if (f.parts[v] != VertexPart::Skin) continue;
+            const auto p = f.mesh.point(TriMesh::VertexHandle(v));
+            if (f.mesh.normal(TriMesh::VertexHandle(v))[2] < 0.3) continue;
+            if (std::hypot(std::abs(p[0]) - cx, p[1] - cy) > 5.0) continue;
+            const Texel t = texel_of(v);
+            m = {m.r + t.r, m.g + t.g, m.b + t.b, 0};
+            ++n;
+        }
+        EXPECT_GT(n, 4) << "at " << cx << ", " << cy;
+        return Texel{m.r / std::max(n, 1), m.g / std::max(n, 1), m.b / std::max(n, 1), 0};
+    };
+    const Texel cheek = mean(38, -30), jaw = mean(40, -78), forehead = mean(20, 45);
+    EXPECT_GT(jaw.b / jaw.r, cheek.b / cheek.r + 0.03) << "the beard zone's bluish-grey cast";
+    EXPECT_LT(forehead.b / forehead.g, cheek.b / cheek.g - 0.02) << "the forehead yellower";
+}
+
 // Alpha is the region's roughness scale: lips and the nose (T-zone) are
 // glossier than the cheek, the hair and cheek are 1.
 TEST(FaceTexture, AlphaHoldsTheRegionsRoughness) {
