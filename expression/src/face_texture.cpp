@@ -538,7 +538,13 @@ Texel Painter::skin(glm::dvec3 q) const {
     // it so the two do not move together.
     // Both have a broad component (tens of mm: the blotchiness seen at a
     // glance) under the finer one.
-    const double pigment = 0.6 * fbm(q.x * 0.08, q.y * 0.08, q.z * 0.08) + 0.4 * noise(q.x * 0.03, q.y * 0.03, q.z * 0.03 + 21.0);
+    // A third, broader scale (about 60 mm: one side of the forehead or a
+    // cheek a shade lighter than the other) so the mottling reads at 512 px,
+    // where the finer scales fall below a few pixels and average out. All
+    // three are wider than the albedo relief's blur (skin.json
+    // albedo_detail), so they stay colour and do not turn into lumps.
+    const double pigment = 0.45 * fbm(q.x * 0.08, q.y * 0.08, q.z * 0.08) + 0.3 * noise(q.x * 0.03, q.y * 0.03, q.z * 0.03 + 21.0) +
+                           0.25 * noise(q.x * 0.016 + 7.0, q.y * 0.016, q.z * 0.016 + 25.0);
     Rgb c = skin * (1.0 + al.pigment_variation * (pigment - 0.5) - 0.5 * half);
     const double blood = 0.55 * fbm(q.x * 0.21 + 11.0, q.y * 0.21, q.z * 0.21) + 0.45 * noise(q.x * 0.06, q.y * 0.06, q.z * 0.06 + 23.0);
     c = redden(c, al.mottling * (blood - 0.45));
@@ -596,6 +602,17 @@ Texel Painter::skin(glm::dvec3 q) const {
                              (0.75 + 0.5 * noise(q.x * 1.7, q.y * 1.7, q.z * 1.7)) *
                              (ax > 55.0 ? 1.0 - std::min(1.0, s_.ear_relief(q.y, q.z)) : 1.0);  // not on the lobe
         c = tint(c, al.beard_tint, al.beard_amount * beard);
+        // Stubble: the cut hairs' dark ends in their follicles, about a
+        // millimetre apart, each a dot a few tenths of a mm across, most
+        // where the beard is densest. A grey cast alone read as a bluish
+        // smear; the dots give it a grain at a 1024 px crop.
+        if (beard > 0.05) {
+            // Laid out round the jaw (|x| - z grows along the skin from the
+            // chin to the cheek's side), each side its own dots.
+            const double around = (q.x >= 0.0 ? 1.0 : -1.0) * (ax - q.z + 200.0);
+            const double dot = spots(around, q.y, 0.75, 0.8, 0.22, 171);
+            c = blend(c, c * Rgb{0.62, 0.62, 0.66}, std::min(1.0, 1.1 * al.beard_amount * beard) * dot);
+        }
     }
     // The face's own colouring (redness, freckles, lids, lips, brows) fades
     // in towards the front instead of starting at a cut.
@@ -610,7 +627,16 @@ Texel Painter::skin(glm::dvec3 q) const {
         double flush = 0.0;
         for (const auto& f : al.flush)
             flush += f.amount * field(f.centre[0] == 0.0 ? q.x : ax, q.y, f.centre[0], f.centre[1], f.size[0], f.size[1]);
-        c = redden(c, flush * breakup * capillaries * (1.0 + 2.5 * half));
+        // Within the flush the blood pools unevenly, a few mm across: the
+        // cheek's redness is a blotchy net, densest over the cheekbone, not
+        // an even wash (an even wash at any strength read as rouge or as
+        // one waxy tone). The broad share darkens as blood does; the
+        // blotchy share is hue only, since the renderer's albedo relief
+        // would bump a blotch's darkening into a lump.
+        const double pooled = glm::smoothstep(0.3, 0.72, fbm(q.x * 0.3 + 17.0, q.y * 0.3, q.z * 0.1 + 33.0));
+        const double amount = flush * breakup * (1.0 + 2.5 * half);
+        c = redden(c, 0.75 * amount * capillaries);
+        c = redden_hue(c, 0.6 * amount * (pooled - 0.35) * capillaries);
         // Regional casts: the bridge yellower, violet under the eyes, the
         // temples a little bluer (veins under thin skin); broken up like
         // the flush so none reads as a painted shape.
@@ -839,6 +865,19 @@ Texel Painter::skin(glm::dvec3 q) const {
             const double inside = std::min(1.0, e / 3.0);
             c = redden(c, al.ear_flush * inside * (1.0 + 0.8 * std::max(-fold, 0.0)));
             c = c * (1.0 + inside * (0.12 * std::max(fold, 0.0) - al.ear_fold_shade * std::max(-fold, 0.0)));
+            // The free rim (helix, lobe) is thin enough for light to pass
+            // through: redder and more saturated over its last few mm,
+            // where a step outwards leaves the ear (ear_relief is 0 off
+            // it). Without it the ears read as pale flaps beside the face.
+            const double dy = q.y - p_.ear_centre_yz[0], dz = q.z - p_.ear_centre_yz[1];
+            const double out = std::hypot(dy, dz);
+            if (out > 1e-6) {
+                constexpr double kRim = 4.0;  // mm
+                const double beyond = s_.ear_relief(q.y + kRim * dy / out, q.z + kRim * dz / out);
+                const double rim = inside * (1.0 - std::min(1.0, beyond / 2.0));
+                c = redden(c, 0.6 * al.ear_flush * rim);
+                c = c * (1.0 + 0.06 * rim);
+            }
         }
     }
     Rgb hc;
