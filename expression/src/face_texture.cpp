@@ -406,7 +406,15 @@ double Painter::hair(glm::dvec3 q, Rgb* colour, double* roots) const {
     // The hairline: the mass of hair thins over the band, and single fine
     // hairs grow from it over the skin, fewer the further out; each lies
     // along the strands' flow, tip away from the crown.
-    const double density = glm::smoothstep(-0.2 * band, 0.7 * band, edge);
+    // The mass thins unevenly: its clumps reach further out than the
+    // partings between them, and patches a few mm across thin early, so
+    // the skin shows through in streaks along the strands. One smooth
+    // gradient along the line read, where the temples turn away from the
+    // camera and squeeze the band into a few pixels, as a helmet's hard
+    // edge (blind review, issue 11).
+    const double ragged = band * (0.25 * (0.5 - clump_edge) + 0.15 * (strands - 0.5) +
+                                  0.3 * (noise(q.x * 0.22 + 5.0, q.y * 0.22, q.z * 0.22 + 31.0) - 0.5));
+    const double density = glm::smoothstep(-0.2 * band, 0.7 * band, edge + ragged);
     if (density >= 1.0) return 1.0;
     // Hairs on a jittered grid in strand coordinates (mm across at the
     // hairline's distance from the crown, mm along).

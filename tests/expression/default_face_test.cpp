@@ -204,6 +204,35 @@ TEST(DefaultFace, NeckIsSmoothAcrossTheMidline) {
     EXPECT_LT(worst, 0.12f) << "a crease runs down the base of the throat at x = 0";
 }
 
+// The sternocleidomastoids stand out on the throat (face.json head.parts):
+// across the neck's front above the collar, a cylinder's surface falls away
+// ever faster towards its sides, while over the two cords (|x| 16-28 mm) it
+// stays nearly level before falling off outside them. The front surface's
+// mean slope over the cords, as a share of its slope just outside them
+// (|x| 32-40), at 140 and 145 mm below the eyes: measured 0.55 with the
+// cords sunk in the neck (a smooth tube at 512 px, blind review, issue 11),
+// 0.17 with them on its surface.
+TEST(DefaultFace, NeckShowsTheSternocleidomastoidsAsRidges) {
+    const Face& f = test_face();
+    auto front_z = [&](double y0, double x) {
+        float z = -1e9f;
+        for (int v = 0; v < f.vertex_count(); ++v) {
+            if (f.parts[v] != VertexPart::Skin) continue;
+            const auto q = f.mesh.point(TriMesh::VertexHandle(v));
+            if (std::abs(std::abs(q[0]) - x) < 2.0 && std::abs(q[1] - y0) < 5.0) z = std::max(z, q[2]);
+        }
+        return static_cast<double>(z);
+    };
+    double share = 0.0;
+    for (double y : {-140.0, -145.0}) {
+        const double over_cords = (front_z(y, 16) - front_z(y, 28)) / 12.0;
+        const double outside = (front_z(y, 32) - front_z(y, 40)) / 8.0;
+        ASSERT_GT(outside, 0.3) << "the neck's front falls away to its sides at y = " << y;
+        share += 0.5 * over_cords / outside;
+    }
+    EXPECT_LT(share, 0.35) << "the front surface's slope over the cords, of that outside them";
+}
+
 // The bust is a portrait's (face.json resolution.bust, head.shoulders): the
 // shoulders slope down from the neck and out past the default frame's sides
 // (about 190 mm out at z 0), above its bottom (about -205 mm), on both

@@ -233,9 +233,11 @@ TEST(FaceTexture, HairlineIsASoftSmoothBand) {
 
 // Stray strands hang over the forehead below the hairline's band (face.json
 // hair forelock): over the middle of the forehead, between 44 and 52 mm up
-// (the line is at about 64-70, its band and fine hairs end above 50), a
-// share of the texels are hair-dark; on the same face without the forelock
-// none are (measured: 3.5 % and 0).
+// (the line is at about 62-70), a share of the texels are hair-dark, far
+// more than on the same face without the forelock, where only the band's
+// sparse fine hairs reach (measured: 3.96 % and 0.72 %; none until session
+// 9 widened the band to 18 mm and grew the fine hairs to 8 mm, so the line
+// thins out over the skin instead of stopping at an edge).
 TEST(FaceTexture, ForelockStrandsHangOverTheForehead) {
     auto dark_share = [](const Face& f) {
         const double skin = luminance_between(0.0, 38.0, 40.0, 1, f)[0];
@@ -249,8 +251,8 @@ TEST(FaceTexture, ForelockStrandsHangOverTheForehead) {
         return static_cast<double>(dark) / n;
     };
     const double with = dark_share(painted_face()), without = dark_share(face_without_forelock());
-    EXPECT_GT(with, 0.01) << with << " with the forelock, " << without << " without";
-    EXPECT_LT(without, 0.001) << with << " with the forelock, " << without << " without";
+    EXPECT_GT(with - without, 0.02) << with << " with the forelock, " << without << " without";
+    EXPECT_LT(without, 0.015) << with << " with the forelock, " << without << " without";
 }
 
 // Cheeks are redder than the forehead, but diffusely: the redness excess at
