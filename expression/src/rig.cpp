@@ -77,16 +77,23 @@ double radius_factor(std::string_view id) {
 // the fold's upper part); it moves by kMassUp of that up, kMassForward forward
 // and kMassOut out (kMassUp < 0: see below), most at its centre, nothing medial to the fold.
 // Observers saw a smile that "moves only the mouth" when the cheek only slid
-// up with the skin (issue 11); a Duchenne cheek comes 3-5 mm forward.
+// up with the skin (issue 11); a Duchenne cheek comes 3-6 mm forward. At
+// kMassForward 0.35 (joy 4.7 mm) a blind observer still saw cheeks that "do
+// not lift enough" at 512 px; 0.45 brings joy's 6 mm.
 constexpr double kCornerShare = 1.2, kUpperLipShare = 1.0;
 // The sheet already carries the mass up with the cheek point; held back by a
 // tenth of its rise, it does not crowd the skin under the lower lid further
 // (which creased it past the smoothness bound).
-constexpr double kMassUp = -0.1, kMassForward = 0.35, kMassOut = 0.06;
+constexpr double kMassUp = -0.1, kMassForward = 0.45, kMassOut = 0.06;
 // Its reach from its centre, and the fold's width (inside, outside), in ES0.
 constexpr double kMassRadius = 0.45, kFoldInside = 0.02, kFoldOutside = 0.10;
 // Its centre's share of the cheekbone (5.3) against the nose wing (9.1).
 constexpr double kCentreOnCheekbone = 0.6;
+// The lower lid's share of the cheek's rise at its widest (AU6 pushing it
+// from below), how sharply that share peaks there (a power of the opening's
+// fraction: the ends stay), and how far below the margin the lid's skin
+// follows (in lid fades).
+constexpr double kCheekPush = 0.28, kCheekPushPeak = 3.0, kCheekPushFade = 1.5;
 
 // C2 bell, 1 at t = 0 and flat there, 0 from t = 1 on.
 double wendland(double t) { return t >= 1.0 ? 0.0 : std::pow(1.0 - t, 4) * (4.0 * t + 1.0); }
@@ -446,6 +453,27 @@ void FaceRig::build_point_field(const Face& face, double radius_scale) {
                 if (t >= 1.0) continue;
                 const double w = kBulge * std::min(opening(x) / o_fp, 1.0) * std::pow(std::sin(kPi * std::pow(t, 0.75)), 2);
                 if (w > 1e-5) lid_weights_.push_back({v, bulge, static_cast<float>(w)});
+            }
+            // The rising cheek (AU6) pushes the lower lid up from below,
+            // most where the eye is open widest: the margin's middle rises
+            // over its ends and the lid arches up (the smiling eye), and the
+            // lid's skin rises with it so the cheek and lid move as one. The
+            // lid FAP alone (AU7) lifts the margin in proportion to the
+            // opening, keeping its hollow; a Duchenne lid with only that
+            // looked sleepy, not smiling, to observers (issue 11).
+            const int cheek = fap::feature_point_index(side == 0 ? "5.3" : "5.4");
+            if (fps_[cheek].present && fps_[cheek].vertex >= 0) {
+                const int push = add_entry(cheek, Driven::Follow);
+                for (auto [v, g] : graph.within({src}, 0.5 * es0 * radius_scale)) {
+                    if (parts_[v] != VertexPart::Skin) continue;
+                    const double x = neutral_[v][0], y = neutral_[v][1];
+                    double ym;
+                    if (!margin_y(margin, x, &ym) || ym - y < -1e-3) continue;
+                    const double open = std::min(opening(x) / o_fp, 1.0);
+                    const double w = kCheekPush * std::pow(open, kCheekPushPeak) *
+                                     raised_cosine(std::max(ym - y, 0.0) / (kCheekPushFade * fade));
+                    if (w > 1e-5) lid_weights_.push_back({v, push, static_cast<float>(w)});
+                }
             }
             continue;
         }

@@ -85,6 +85,10 @@ TEST(RigCheek, ASmileBringsTheCheekForwardAndUpBesideADeeperFold) {
         {"AU20 lip stretcher", au(20), -0.3, 0.3, -1.0},
         {"AU4 brow lowerer", au(4), -0.3, 0.3, -1.0},
         {"AU7 lid tightener", au(7), -0.3, 0.3, -1.0},
+        // Nor do the emotions without AU6, AU9, AU10 or AU12.
+        {"sadness", profiles()[Emotion::Sadness], -0.3, 0.3, -1.0},
+        {"fear", profiles()[Emotion::Fear], -0.3, 0.3, -1.0},
+        {"anger", profiles()[Emotion::Anger], -0.3, 0.3, -1.0},
     };
     for (const Case& c : cases) {
         const CheekReading r = read_cheek(c.faps);

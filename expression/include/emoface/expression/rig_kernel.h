@@ -22,7 +22,7 @@ namespace emoface::expression {
 namespace rig_kernel {
 // Sizes of the per-frame tables (checked when the rig is built).
 constexpr int kMaxSystem = 84;  // point-field entries: at most one per feature point
-constexpr int kMaxLidFps = 10;  // 3.1-3.4 and the inner brows (lids, bulges) and 5.3-5.4 (cheek masses)
+constexpr int kMaxLidFps = 12;  // 3.1-3.4 and the inner brows (lids, bulges), 5.3-5.4 (cheek masses, the lower lids' push)
 constexpr int kMaxEyes = 4;
 }  // namespace rig_kernel
 
