@@ -929,12 +929,29 @@ void Generator::build_mouth_interior(Face& face) {
     arch(true);
     arch(false);
 
-    // Tongue: an ellipsoid resting on the cavity floor, tip (+z pole) forward.
+    // Tongue: a body filling the lower arch, tip (+z pole) forward against
+    // the lower incisors' lingual faces. Its dorsum rises from the tip to
+    // behind its middle (kTipDrop: the front half's height is that much
+    // lower at the tip's end), above the lower incisors' edges, and its
+    // cross-section is flat on top with rounded margins (kSection, a
+    // superellipse's exponent). Seen from the front through an open mouth,
+    // the dorsum then fills the opening's lower part behind the lower
+    // teeth; a flat ellipsoid lying under the incisors' edges showed only
+    // its front rim, and the open mouth was a black hole (blind review,
+    // session 9).
     {
         const glm::dvec3 tc{p_.tongue_centre[0], p_.tongue_centre[1], p_.tongue_centre[2]};
         const glm::dvec3 r{p_.tongue_radii[0], p_.tongue_radii[1], p_.tongue_radii[2]};
-        tongue_rings_ = 10;
-        tongue_segments_ = 16;
+        constexpr double kTipDrop = 0.35, kSection = 0.75;
+        auto body = [&](double a, double b) {
+            const double sa = std::sin(a), ca = std::cos(a);
+            auto boxy = [&](double c) { return (c < 0 ? -1.0 : 1.0) * std::pow(std::abs(c), kSection); };
+            const double across = boxy(std::cos(b)), up = boxy(std::sin(b));
+            const double height = up > 0 ? r.y * (1.0 - kTipDrop * ca) : r.y;
+            return tc + glm::dvec3{r.x * sa * across, height * sa * up, r.z * ca};
+        };
+        tongue_rings_ = 14;
+        tongue_segments_ = 20;
         auto uv = [&](double a, double b, double& u, double& v) {
             const double rr = 0.48 * a / kPi;
             u = detail::tile_u0(Tile::Tongue) + detail::kTile * (0.5 + rr * std::cos(b));
@@ -950,10 +967,7 @@ void Generator::build_mouth_interior(Face& face) {
             for (int s = 0; s < tongue_segments_; ++s) {
                 const double b = 2 * kPi * s / tongue_segments_;
                 uv(a, b, u, v);
-                add_vertex(face,
-                           tc + glm::dvec3{r.x * std::sin(a) * std::cos(b), r.y * std::sin(a) * std::sin(b),
-                                           r.z * std::cos(a)},
-                           u, v, VertexPart::Tongue);
+                add_vertex(face, body(a, b), u, v, VertexPart::Tongue);
             }
         }
         uv(kPi, 0, u, v);

@@ -972,8 +972,9 @@ Rgb Painter::tile(double u, double v) const {
             // albedo stays a mid red to the back: 0.3 there rendered black.
             // 0.6 at the back still read as a shallow red box behind the
             // teeth (blind review, session 8): the back wall now a deep
-            // shade, the rim by the lips as before.
-            return from255(p_.mouth) * (0.42 + 0.5 * glm::smoothstep(0.2, 1.0, std::min(r, 1.0)));
+            // shade, the rim by the lips as before. At 0.42 the strip of it
+            // above the tongue rendered flat black (session 9): 0.5.
+            return from255(p_.mouth) * (0.5 + 0.42 * glm::smoothstep(0.2, 1.0, std::min(r, 1.0)));
         case Tile::Teeth: {
             const bool upper = lv >= 0.5;
             const double c = ((upper ? lv - 0.5 : lv) - 0.02) / 0.46 * 3.0;  // 0 root, 1 edge (front), 3 root (back)
@@ -1007,12 +1008,23 @@ Rgb Painter::tile(double u, double v) const {
             const Rgb gums{0.74, 0.4, 0.4};
             return blend(teeth, gums * (0.85 + 0.15 * glm::smoothstep(0.1, 0.25, front)), gum);
         }
-        case Tile::Tongue:
+        case Tile::Tongue: {
             // Its tip (the tile's centre) lit through the lips, its body
             // falling into the mouth's shade: an even red filled the open
-            // mouth as a flat red mass.
-            return from255(p_.tongue) * (0.85 + 0.25 * noise(lu * 40, lv * 40, 2.0)) *
-                   (1.0 - 0.55 * glm::smoothstep(0.12, 0.6, std::min(r, 1.0)));
+            // mouth as a flat red mass. The occlusion bake darkens the body
+            // with its depth too, so the fall here is gentle: at 0.55 the
+            // dorsum the open mouth shows was a dark red slab.
+            Rgb tongue = from255(p_.tongue) * (0.85 + 0.25 * noise(lu * 40, lv * 40, 2.0)) *
+                         (1.0 - 0.4 * glm::smoothstep(0.2, 0.75, std::min(r, 1.0)));
+            // The median sulcus: a shallow groove down the dorsum's middle
+            // (the top half of the tile, beta = pi / 2), from behind the tip
+            // to the back; about 1.5 mm either side of the midline on a
+            // tongue 34 mm wide.
+            const double across = std::sin(kPi * std::min(r, 1.0)) * std::cos(beta) * 17.0;
+            const double sulcus = std::exp(-(across / 1.5) * (across / 1.5)) * glm::smoothstep(0.12, 0.3, r) *
+                                  glm::smoothstep(0.0, 0.3, std::sin(beta));
+            return tongue * (1.0 - 0.25 * sulcus);
+        }
     }
     return {};
 }

@@ -428,6 +428,34 @@ TEST(DefaultFace, IncisorsShowBelowTheUpperLipWithAnOverbite) {
     EXPECT_GT(upper[2] - lower[2], 1.0);
 }
 
+// The tongue fills the lower arch (default_face.cpp): its tip rests behind
+// the lower incisors and below their edge, and its dorsum rises above that
+// edge behind its middle, so an open mouth shows its top behind the lower
+// teeth (the old flat ellipsoid lay under the edge: the open mouth showed
+// a black cavity).
+TEST(DefaultFace, TongueDorsumRisesAboveTheLowerIncisorsBehindThem) {
+    const Face& face = test_face();
+    const Vec3d edge = face.position(fp("9.11")), tip = face.position(fp("6.1")), dorsum = face.position(fp("6.2"));
+    // Measured: the tip 5.6 mm behind the edge's labial face and 5.5 below
+    // the edge, the dorsum's middle 1.0 above it, its top 1.3 above it 4.5
+    // mm behind the middle.
+    EXPECT_LT(tip[2], edge[2] - 3.0);
+    EXPECT_LT(tip[1], edge[1] - 2.0);
+    EXPECT_GT(dorsum[1], edge[1] + 0.5);
+    double highest = -1e9, highest_z = 0.0, front = -1e9;
+    for (int v = 0; v < face.vertex_count(); ++v) {
+        if (face.parts[v] != VertexPart::Tongue) continue;
+        const auto q = face.mesh.point(TriMesh::VertexHandle(v));
+        front = std::max(front, double(q[2]));
+        if (q[1] > highest) highest = q[1], highest_z = q[2];
+    }
+    std::printf("tongue: tip %.1f mm behind and %.1f below the lower edge, dorsum %.1f above it, top %.1f above it %.1f behind the middle, front %.1f behind the edge\n",
+                edge[2] - tip[2], edge[1] - tip[1], dorsum[1] - edge[1], highest - edge[1], dorsum[2] - highest_z, edge[2] - front);
+    EXPECT_LT(front, edge[2] - 3.0) << "the tongue reaches through the lower incisors";
+    EXPECT_GT(highest, edge[1] + 0.5);
+    EXPECT_LT(highest_z, dorsum[2] + 1.0) << "the dorsum is highest at or behind its middle";
+}
+
 TEST(DefaultFace, BaseColourPaintsLipsRedderThanSkinAndHairDarker) {
     DefaultFaceOptions options;
     options.resolution_scale = 0.5;
