@@ -69,6 +69,7 @@ struct ExportArgs {
     double face_resolution = 1.0;
     double fap_step = 0;  // 0: per FAP, from its range
     int wrinkle_size = 512;
+    int texture_size = 0;  // 0: face.json's
     bool no_wrinkles = false;
 };
 
@@ -82,6 +83,7 @@ ex::Face load_face(const ExportArgs& a) {
             fail<InputError>("export: data folder {}: no face/ there (point --data at the project's data/)", a.data);
         ex::DefaultFaceOptions fo;
         fo.resolution_scale = a.face_resolution;
+        fo.texture_size = a.texture_size;
         return ex::make_default_face(a.data + "/face", fo);
     }
     std::error_code ec;
@@ -122,6 +124,8 @@ void export_gltf(const ExportArgs& a) {
         fail<InputError>("export: give an animation file or --mix, not both");
     emoface::apps::check_in_range("export", "--face-resolution", a.face_resolution, 0.1, 2.0);
     emoface::apps::check_in_range("export", "--wrinkle-size", a.wrinkle_size, 256, 4096);
+    if (a.texture_size != 0)
+        emoface::apps::check_in_range("export", "--texture-size", a.texture_size, 64, 8192, " (0: face.json's)");
     const bool wrinkles = !a.no_wrinkles && gltf::wrinkles_available();
     emoface::apps::OutputFile out(a.out, "export", "--out");
 
@@ -621,6 +625,10 @@ void add_export_command(CLI::App& root) {
     sub->add_option("--face-resolution", a->face_resolution, "The default face's mesh resolution (0.1..2)")
         ->capture_default_str();
     sub->add_option("--wrinkle-size", a->wrinkle_size, "Side of the wrinkle key maps in pixels (256..4096)")
+        ->capture_default_str();
+    // As mix's and face's: the base colour's painting is most of an export's
+    // time, which the tests, checking the mesh and its targets, need not pay.
+    sub->add_option("--texture-size", a->texture_size, "Base-colour image side of the default face (0: face.json's)")
         ->capture_default_str();
     sub->add_flag("--no-wrinkles", a->no_wrinkles, "Leave the wrinkle key maps out");
     sub->add_option("--data", a->data, "The project's data folder")->capture_default_str();

@@ -37,6 +37,7 @@ namespace {
 
 namespace fs = std::filesystem;
 namespace ex = emoface::expression;
+using emoface::testing::args_with;
 using emoface::testing::CommandResult;
 using emoface::testing::run_emoface;
 
@@ -44,6 +45,10 @@ const std::string kData = EMOFACE_DATA_DIR;
 const std::string kRealFap = std::string(EMOFACE_REALDATA_DIR) + "/fap";
 // A coarser mesh keeps the test fast; the rig and the export are the same code at any resolution.
 const std::string kResolution = "0.5";
+// So does a small base colour: painting face.json's 2048 x 2048 image (and
+// compressing it to PNG) was most of each export's time. One export, the
+// validator's acceptance case, keeps every default.
+const std::string kTextureSize = "64";
 
 // A float accessor's values, dense or sparse (zeros, or its buffer view,
 // with the sparse entries written over them).
@@ -90,9 +95,12 @@ std::vector<std::string> target_names(const tinygltf::Model& m) {
     return names;
 }
 
-// Runs scripts/gltf_validate.js; "" when node or the validator is absent.
-std::string validate(const std::string& glb, int& status) {
-    const std::string cmd = fmt::format("node {}/../scripts/gltf_validate.js '{}' 2>&1", kData, glb);
+// Runs scripts/gltf_validate.js over the files (one node, one validator
+// load); "" when node or the validator is absent.
+std::string validate(const std::vector<std::string>& glbs, int& status) {
+    std::string files;
+    for (const std::string& g : glbs) files += " '" + g + "'";
+    const std::string cmd = fmt::format("node {}/../scripts/gltf_validate.js{} 2>&1", kData, files);
     FILE* p = popen(cmd.c_str(), "r");
     if (!p) return "";
     std::string out;
@@ -173,7 +181,8 @@ protected:
 
 TEST_F(ExportCli, TargetsAreNamedAndTheAnimationHasTheFileTimes) {
     const std::string out = path("tour.glb");
-    CommandResult r = run_emoface({"export", kData + "/fap/tour.fap", "--out", out, "--face-resolution", kResolution});
+    CommandResult r = run_emoface({"export", kData + "/fap/tour.fap", "--out", out, "--face-resolution", kResolution,
+                                   "--texture-size", kTextureSize, "--no-wrinkles"});
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const tinygltf::Model m = load_glb(out);
     ASSERT_EQ(m.meshes.size(), 1u);
@@ -186,8 +195,13 @@ TEST_F(ExportCli, TargetsAreNamedAndTheAnimationHasTheFileTimes) {
         EXPECT_NE(std::find(names.begin(), names.end(), n), names.end()) << n;
     EXPECT_EQ(std::count_if(names.begin(), names.end(), [](const std::string& s) { return s.rfind("viseme_", 0) == 0; }),
               14);
+    const auto base_colour =
+        std::find_if(m.images.begin(), m.images.end(), [](const tinygltf::Image& i) { return i.name == "base_colour"; });
+    ASSERT_NE(base_colour, m.images.end());  // the base colour, embedded, at the size asked
     EXPECT_EQ(std::count_if(m.images.begin(), m.images.end(), [](const tinygltf::Image& i) { return i.name == "base_colour"; }),
-              1);  // the base colour, embedded
+              1);
+    EXPECT_EQ(base_colour->width, std::stoi(kTextureSize));
+    EXPECT_EQ(base_colour->height, std::stoi(kTextureSize));
     ASSERT_EQ(m.animations.size(), 1u);
     const std::vector<float> t = floats(m, m.animations[0].samplers[0].input);
     const std::vector<float> w = floats(m, m.animations[0].samplers[0].output);
@@ -199,23 +213,27 @@ TEST_F(ExportCli, TargetsAreNamedAndTheAnimationHasTheFileTimes) {
 
 TEST_F(ExportCli, TheValidatorFindsNoErrors) {
     // The .glb each writes, then its arguments.
+    const std::vector<std::string> small = {"--face-resolution", kResolution, "--texture-size", kTextureSize,
+                                            "--wrinkle-size", "256"};
     std::vector<std::pair<std::string, std::vector<std::string>>> cases = {
-        {path("neutral.glb"), {"--face-resolution", kResolution}},
-        {path("mix.glb"), {"--mix", "0.7 joy + 0.3 AU4", "--face-resolution", kResolution}},
-        {path("tour.glb"), {kData + "/fap/tour.fap", "--face-resolution", kResolution}}};
-    if (fs::exists(kRealFap + "/xface_joy.fap"))
-        cases.push_back({path("joy.glb"), {kRealFap + "/xface_joy.fap"}});  // the acceptance: full resolution
+        {path("neutral.glb"), small},
+        {path("mix.glb"), args_with({"--mix", "0.7 joy + 0.3 AU4"}, small)},
+        {path("tour.glb"), args_with({kData + "/fap/tour.fap"}, small)}};
+    if (fs::exists(kRealFap + "/xface_joy.fap"))  // the acceptance: every default (full resolution, texture, keys)
+        cases.push_back({path("joy.glb"), {kRealFap + "/xface_joy.fap"}});
+    std::vector<std::string> glbs;
     for (auto& [glb, args] : cases) {
         args.insert(args.begin(), {"export", "--out", glb});
         CommandResult r = run_emoface(args);
         ASSERT_EQ(r.exit_code, 0) << r.err;
-        int status = -1;
-        const std::string report = validate(glb, status);
-        if (status == 127 || status == 3 || report.empty())
-            GTEST_SKIP() << "node or the npm package gltf-validator is absent (scripts/deps installs them): " << report;
-        EXPECT_EQ(status, 0) << report;
-        EXPECT_NE(report.find(": 0 errors"), std::string::npos) << report;
+        glbs.push_back(glb);
     }
+    int status = -1;
+    const std::string report = validate(glbs, status);
+    if (status == 127 || status == 3 || report.empty())
+        GTEST_SKIP() << "node or the npm package gltf-validator is absent (scripts/deps installs them): " << report;
+    EXPECT_EQ(status, 0) << report;
+    for (const std::string& glb : glbs) EXPECT_NE(report.find(glb + ": 0 errors"), std::string::npos) << report;
 }
 
 // The glTF mesh, its targets and the animation's weights, evaluated as a
@@ -225,6 +243,7 @@ TEST_F(ExportCli, ReproducesTheRigOnRealFapFiles) {
     if (!fs::is_directory(kRealFap)) GTEST_SKIP() << kRealFap << " is absent: no real FAP files to compare with";
     ex::DefaultFaceOptions fo;
     fo.resolution_scale = std::stod(kResolution);
+    fo.texture_size = 16;  // the mesh is what is compared
     const ex::Face face = ex::make_default_face(kData + "/face", fo);
     ex::RigOptions ro;
     ro.ranges = ex::load_fap_ranges(kData + "/expression/fap_ranges.json");
@@ -243,7 +262,8 @@ TEST_F(ExportCli, ReproducesTheRigOnRealFapFiles) {
         if (anim.stream.frames.empty()) continue;
         const std::string out = path(file.stem().string() + ".glb");
         CommandResult r =
-            run_emoface({"export", file.string(), "--out", out, "--face-resolution", kResolution, "--no-wrinkles"});
+            run_emoface({"export", file.string(), "--out", out, "--face-resolution", kResolution, "--texture-size",
+                         kTextureSize, "--no-wrinkles"});
         ASSERT_EQ(r.exit_code, 0) << r.err;
         const tinygltf::Model m = load_glb(out);
         const std::size_t nf = anim.stream.frames.size();
@@ -268,7 +288,8 @@ TEST_F(ExportCli, ReproducesTheRigOnRealFapFiles) {
 // triangle once.
 TEST_F(ExportCli, PartsHaveTheirOwnMaterials) {
     const std::string out = path("parts.glb");
-    CommandResult r = run_emoface({"export", "--out", out, "--face-resolution", kResolution, "--no-wrinkles"});
+    CommandResult r = run_emoface(
+        {"export", "--out", out, "--face-resolution", kResolution, "--texture-size", kTextureSize, "--no-wrinkles"});
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const tinygltf::Model m = load_glb(out);
     std::map<std::string, double> roughness;
@@ -288,6 +309,7 @@ TEST_F(ExportCli, PartsHaveTheirOwnMaterials) {
     EXPECT_LT(roughness["mouth"], roughness["skin"]);
     ex::DefaultFaceOptions fo;
     fo.resolution_scale = std::stod(kResolution);
+    fo.texture_size = 16;  // only its triangles are counted
     EXPECT_EQ(indices, 3 * ex::make_default_face(kData + "/face", fo).mesh.n_faces());
 }
 
@@ -298,7 +320,7 @@ TEST_F(ExportCli, PartsHaveTheirOwnMaterials) {
 TEST_F(ExportCli, WrinkleKeysGoAlongWithTheirAuTargets) {
     const std::string out = path("wrinkles.glb");
     CommandResult r = run_emoface({"export", kData + "/fap/tour.fap", "--out", out, "--face-resolution", kResolution,
-                                   "--wrinkle-size", "256"});
+                                   "--texture-size", kTextureSize, "--wrinkle-size", "256"});
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const tinygltf::Model m = load_glb(out);
     const tinygltf::Value& extras = m.meshes.at(0).extras;
@@ -346,13 +368,16 @@ TEST_F(ExportCli, WrinkleKeysGoAlongWithTheirAuTargets) {
 }
 
 TEST_F(ExportCli, BadInputIsOneLineExitTwoAndNoFile) {
+    // The animation and the mix are read after the face is built: a small one.
+    const std::vector<std::string> small = {"--face-resolution", kResolution, "--texture-size", kTextureSize};
     const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
         {{"export", "--out", path("a.gltf")}, "expected a file ending in .glb"},
-        {{"export", path("missing.fap"), "--out", path("b.glb")}, "missing.fap"},
+        {args_with({"export", path("missing.fap"), "--out", path("b.glb")}, small), "missing.fap"},
         {{"export", kData + "/fap/tour.fap", "--mix", "joy", "--out", path("c.glb")}, "not both"},
         {{"export", "--face", path("nope.obj"), "--out", path("d.glb")}, "no such file"},
-        {{"export", "--mix", "0.5 glee", "--out", path("e.glb")}, "glee"},
+        {args_with({"export", "--mix", "0.5 glee", "--out", path("e.glb")}, small), "glee"},
         {{"export", "--wrinkle-size", "100", "--out", path("f.glb")}, "--wrinkle-size 100: expected 256..4096"},
+        {{"export", "--texture-size", "5", "--out", path("g.glb")}, "--texture-size 5: expected 64..8192 (0: face.json's)"},
     };
     for (const auto& [args, says] : cases) {
         CommandResult r = run_emoface(args);
