@@ -191,6 +191,7 @@ FaceRig::FaceRig(const Face& face, const RigOptions& options) {
         fail<InputError>("expression: rig: face \"{}\" has no FAPU (call update_fapu)", face.name);
 
     build_point_field(face, options.radius_scale);
+    build_corner_glide(face);
     build_jaw(face);
     build_eyes(face);
     build_head(face);
@@ -578,6 +579,50 @@ void FaceRig::build_cheek_masses(detail::GeodesicGraph& graph, double es) {
     }
 }
 
+// The skin around a mouth corner curves back round the dental arch and
+// down to the jaw, facing about 45 degrees out beside the corner. A corner
+// FAP moves the corner along x or y only; the point field carries that
+// motion to the skin around it unchanged, so a corner drawn out by AU20
+// (risorius, 7 mm) lifted the skin beside it 8 mm off the face, a rubber
+// lump lateral to each corner (issue 11: "rubber bulges beside the mouth
+// corners" in fear). Risorius pulls the corner along the face, back over
+// the teeth: the corner moves towards the plane of the skin around it (its
+// mean normal over kGlideReach of the corner's kernel radius), so the sheet
+// beside it slides more and rises less.
+// It glides by kGlide of the way into that plane, outward only (medially
+// and up the corner runs onto the lips and the cheek's front, which face
+// forward): fully, the sheet's edge 15 mm out creased (AU20 61 deg against
+// 39); at 0.35 the skin beside the corner rises 5.8 mm for the corner's
+// 8.3 mm out instead of 8.1 (rig_smoothness_test) and AU20's largest crease
+// is 41.5 deg (was 39.1).
+constexpr double kGlideReach = 0.8, kGlide = 0.35;
+
+void FaceRig::build_corner_glide(const Face& face) {
+    for (int side = 0; side < 2; ++side) {
+        corner_normal_[side] = {0.0, 0.0, 1.0};
+        const int k = fap::feature_point_index(side == 0 ? "8.3" : "8.4");
+        if (!fps_[k].present || system_of_fp_[k] < 0) continue;
+        const V c = to_v(fps_[k].position);
+        const double reach = kGlideReach * system_radius_[system_of_fp_[k]];
+        V sum(0.0);
+        for (auto f : face.mesh.faces()) {
+            std::array<V, 3> p;
+            int i = 0;
+            bool skin = true;
+            for (auto v : face.mesh.fv_range(f)) {
+                skin &= parts_[v.idx()] == VertexPart::Skin;
+                p[i++] = to_v(neutral_[v.idx()]);
+            }
+            if (!skin) continue;
+            const double t = glm::length((p[0] + p[1] + p[2]) / 3.0 - c) / reach;
+            if (t < 1.0) sum += wendland(t) * glm::cross(p[1] - p[0], p[2] - p[0]);  // area-weighted
+        }
+        // A plane steeper than 60 degrees from the front would send the
+        // corner back further than it moves (and faces built so are odd).
+        if (glm::length(sum) > 0 && sum[2] > 0.5 * glm::length(sum)) corner_normal_[side] = glm::normalize(sum);
+    }
+}
+
 void FaceRig::build_jaw(const Face& face) {
     const int n = face.vertex_count();
     jaw_weight_.assign(n, 0.0f);
@@ -747,6 +792,15 @@ void FaceRig::point_displacements(const FapValues& faps, std::array<std::array<d
         if (!fp) continue;
         const double s = value * fapu_.of(info.unit);
         for (int c = 0; c < 3; ++c) d[*fp][c] += s * info.direction[c];
+    }
+    // The corners glide in the plane of the skin around them (build_corner_glide).
+    for (const auto& [side, ids] : {std::pair{0, std::array{"2.4", "8.3"}}, std::pair{1, std::array{"2.5", "8.4"}}}) {
+        const V& nrm = corner_normal_[side];
+        for (const char* id : ids) {
+            auto& p = d[fap::feature_point_index(id)];
+            const double out = side == 0 ? std::max(p[0], 0.0) : std::min(p[0], 0.0);
+            p[2] = -kGlide * nrm[0] * out / nrm[2];
+        }
     }
     // A mouth corner's inner and outer points (2.4 and 8.3) are one corner
     // a lip's thickness apart: they may move apart by at most half that

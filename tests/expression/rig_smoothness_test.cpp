@@ -330,5 +330,42 @@ TEST(RigSmoothness, RealFapFilesLeaveTheMouthCornersWhole) {
     std::printf("ranges clamped %ld of %ld transmitted values (%.2f %%)\n", clamped, values, 100.0 * clamped / values);
 }
 
+// A mouth corner drawn out (AU20, risorius: fear) slides the skin beside
+// it along the face, which curves back there round the teeth: it does not
+// lift it off the face into a lump (issue 11: "rubber bulges beside the
+// mouth corners"). Measured as the largest motion along the neutral skin
+// normal of the skin 3 to 15 mm from the outer corner, against the corner's
+// own outward motion (8.3 mm): 8.1 mm (0.98) when the corner moved along x
+// alone, 5.8 mm (0.70) with the glide (rig.cpp, kGlide).
+TEST(RigSmoothness, SkinBesideAStretchedMouthCornerSlidesRatherThanRises) {
+    const Face& face = test_face();
+    const SkinEdges& e = skin_edges();
+    std::vector<Vec3d> p0(face.vertex_count()), vn(face.vertex_count(), Vec3d{0, 0, 0});
+    for (int v = 0; v < face.vertex_count(); ++v) p0[v] = to_vec(face.mesh.point(TriMesh::VertexHandle(v)));
+    for (const auto& t : e.triangles) {
+        const Vec3d n = normal(p0, t);
+        for (int v : t)
+            for (int c = 0; c < 3; ++c) vn[v][c] += n[c];
+    }
+    const ActionUnit* au20 = nullptr;
+    for (const ActionUnit& au : profiles().action_units.units)
+        if (au.number == 20) au20 = &au;
+    ASSERT_NE(au20, nullptr);
+    const DeformedFace d = test_rig().deform(au20->faps);
+    for (const char* id : {"8.3", "8.4"}) {
+        const Vec3d corner = face.position(fp(id));
+        const double out = std::abs(d.feature_points[fp(id)][0] - corner[0]);
+        ASSERT_GT(out, 5.0) << id;
+        double rise = 0;
+        for (int v = 0; v < face.vertex_count(); ++v) {
+            const double r = norm(sub(p0[v], corner));
+            if (face.parts[v] != VertexPart::Skin || r < 3.0 || r > 15.0 || norm(vn[v]) == 0) continue;
+            rise = std::max(rise, dot(sub(to_vec(d.positions[v]), p0[v]), vn[v]) / norm(vn[v]));
+        }
+        std::printf("AU20 corner %s: %.1f mm out; the skin beside it rises at most %.1f mm\n", id, out, rise);
+        EXPECT_LT(rise, 0.75 * out) << id;
+    }
+}
+
 }  // namespace
 }  // namespace emoface::expression

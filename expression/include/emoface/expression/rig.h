@@ -170,6 +170,12 @@ private:
     std::vector<RigInfluence> weights_;  // system: index into system_fps_
     std::array<int, fap::kFeaturePointCount> system_of_fp_{};    // -1 when not in the system
 
+    // The mouth corners glide over the skin around them (left, right): the
+    // mean outward normal of the skin within the corner's reach, towards
+    // whose plane point_displacements() tilts a corner's outward motion.
+    void build_corner_glide(const Face& face);
+    std::array<glm::dvec3, 2> corner_normal_{};
+
     // Jaw.
     std::vector<float> jaw_weight_;
     std::vector<int> jaw_vertices_;
