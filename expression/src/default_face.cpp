@@ -557,7 +557,17 @@ void Generator::build_eyeball(Face& face, int side) {
         u = detail::tile_u0(detail::Tile::Eye) + detail::kTile * (0.5 + r * std::cos(b));
         v = detail::kTile * (0.5 + r * std::sin(b));
     };
-    const int front = add_vertex(face, c + glm::dvec3{0, 0, R},
+    // How far the cornea stands off the eyeball at angle a off the eye's
+    // axis: its sphere (radius Rc) meets the eyeball's where the two are
+    // cornea_reach off the axis.
+    const double Rc = p_.cornea_radius, reach = std::min(p_.cornea_reach, 0.9 * Rc);
+    const double cornea_base = std::sqrt(R * R - reach * reach) - std::sqrt(Rc * Rc - reach * reach);
+    auto cornea = [&](double a) {
+        const double r = R * std::sin(a);
+        if (a >= kPi / 2 || r >= reach) return 0.0;
+        return std::max(0.0, cornea_base + std::sqrt(Rc * Rc - r * r) - R * std::cos(a));
+    };
+    const int front = add_vertex(face, c + glm::dvec3{0, 0, R + cornea(0.0)},
                                  detail::tile_u0(detail::Tile::Eye) + 0.5 * detail::kTile,
                                  0.5 * detail::kTile, part)
                           .idx();
@@ -568,7 +578,7 @@ void Generator::build_eyeball(Face& face, int side) {
             double u, v;
             uv(a, b, u, v);
             const glm::dvec3 dir{std::sin(a) * std::cos(b), std::sin(a) * std::sin(b), std::cos(a)};
-            add_vertex(face, c + dir * R, u, v, part);
+            add_vertex(face, c + dir * (R + cornea(a)), u, v, part);
         }
     }
     double bu, bv;

@@ -150,6 +150,12 @@ FaceParams read_face_params(const std::string& params_dir) {
             p.eye_radius = r.number("radius");
             p.iris_radius = r.number("iris_radius");
             p.pupil_radius = r.number("pupil_radius");
+            {
+                JsonReader c = r.object("cornea");
+                p.cornea_radius = c.number_in("radius", 5.0, 12.0);
+                p.cornea_reach = c.number_in("reach", 1.0, 5.0);
+                c.finish();
+            }
             p.inner_corner = to_glm(r.numbers<2>("inner_corner"));
             p.outer_corner = to_glm(r.numbers<2>("outer_corner"));
             p.upper_lid_height = r.number("upper_lid_height");

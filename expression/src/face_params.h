@@ -127,6 +127,9 @@ struct FaceParams {
     // eyes (left eye; the right one mirrors it)
     glm::dvec3 eye_centre{0.0};
     double eye_radius = 0.0, iris_radius = 0.0, pupil_radius = 0.0;
+    // The cornea: a sphere of cornea_radius over the eyeball's, meeting it
+    // cornea_reach off the eye's axis (mm).
+    double cornea_radius = 0.0, cornea_reach = 0.0;
     glm::dvec2 inner_corner{0.0}, outer_corner{0.0};
     double upper_lid_height = 0.0, lower_lid_height = 0.0;
     double upper_lid_peak = 0.5, lower_lid_peak = 0.5;

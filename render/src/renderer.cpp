@@ -269,7 +269,7 @@ struct Renderer::Impl {
             light_diffuse, light_specular, specular_color, shininess, camera_position, projective,
             box, skin_model, skin_surface, scatter_table, max_curvature, mm_per_unit,
             normal_softening, cavity_direct, pore_map, pore_tiles, pore_strength, detail_map, albedo_bump, f0, roughness,
-            lobe_weight, gloss_exponent, sheen_intensity, occlusion, key_cone, min_curvature, wrap, hair, wet, key_tint,
+            lobe_weight, gloss_exponent, sheen_intensity, occlusion, key_cone, min_curvature, wrap, hair, wet, wet_sheen, key_tint,
             fill_direction, fill_colour, rim_direction, rim_colour, sky, ground,
             exposure, tone_map;
     } loc{};
@@ -374,6 +374,7 @@ Renderer::Renderer(Platform& platform) : impl_(std::make_unique<Impl>(platform))
     l.wrap = u("u_wrap");
     l.hair = u("u_hair");
     l.wet = u("u_wet");
+    l.wet_sheen = u("u_wet_sheen");
     l.key_tint = u("u_key_tint");
     l.fill_direction = u("u_fill_direction");
     l.fill_colour = u("u_fill_colour");
@@ -660,6 +661,7 @@ void Renderer::draw(const DrawOptions& o, const WrinkleTexture* wrinkle_map) {
         glUniform1f(im.loc.wrap, k.softness);
         glUniform3f(im.loc.hair, k.hair_wrap, k.hair_roughness, k.hair_sheen);
         glUniform4f(im.loc.wet, k.wet_f0, k.wet_broad_roughness, k.wet_broad_weight, k.wet_tight_scale);
+        glUniform1f(im.loc.wet_sheen, k.wet_sheen);
         glUniform3fv(im.loc.key_tint, 1, glm::value_ptr(k.key_tint));
         glUniform3fv(im.loc.fill_direction, 1, glm::value_ptr(glm::normalize(k.fill.direction)));
         glUniform3fv(im.loc.fill_colour, 1, glm::value_ptr(k.fill.colour));

@@ -114,6 +114,7 @@ uniform float u_min_curvature;      // table coordinate: the flattest skin still
 uniform float u_wrap;               // the rig lights' softness (wrapped N.L, energy kept)
 uniform vec3 u_hair;                // hair: wrap, roughness, the lights' sheen
 uniform vec4 u_wet;                 // eyes, mouth: F0, broad lobe's roughness, its weight, tight lobe's scale
+uniform float u_wet_sheen;          // eyes, mouth: the scale of the lights' reflections
 uniform vec3 u_key_tint;
 uniform vec3 u_fill_direction;     // unit vectors
 uniform vec3 u_fill_colour;
@@ -348,6 +349,7 @@ vec3 shade_skin(vec3 n_bumped, vec3 n_geo, vec3 base, float cavity, float gloss,
         roughness = vec2(sqrt(alpha) * u_wet.w, u_wet.y);
         s.lobe_weight = 1.0 - u_wet.z;
         s.f0 = u_wet.x;
+        s.direct_sheen = u_wet_sheen;
         s.n = n_bumped;
         s.n_r = s.n_g = s.n;
         s.curvature = 0.0;

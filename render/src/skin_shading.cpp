@@ -108,7 +108,8 @@ SkinShading load_skin_shading(const std::string& path) {
         s.wet_f0 = float(wet.number_in("f0", 0.0, 1.0));
         s.wet_broad_roughness = float(wet.number_in("broad_roughness", 0.01, 1.0));
         s.wet_broad_weight = float(wet.number_in("broad_weight", 0.0, 1.0));
-        s.wet_tight_scale = float(wet.number_in("tight_scale", 0.05, 1.0));
+        s.wet_tight_scale = float(wet.number_in("tight_scale", 0.05, 4.0));
+        s.wet_sheen = float(wet.number_in("sheen", 0.0, 8.0));
         wet.finish();
 
         JsonReader rig = root.object("light_rig");

@@ -370,12 +370,23 @@ TEST(DefaultFace, EyeballsSitUnderOpenLidsAndPartsAreContiguous) {
         const Eyeball& e = f.eyeballs[side];
         SCOPED_TRACE(side);
         EXPECT_EQ(e.centre[0] > 0, side == 0);
-        // The pupil (3.5 / 3.6) is the eyeball's front pole.
+        // The pupil (3.5 / 3.6) is the eyeball's front pole, on the cornea,
+        // which stands proud of the eyeball's sphere (a catchlight near the
+        // pupil) only inside the iris: the limbus and the white are on it.
         const Vec3d pupil = f.position(fp(side == 0 ? "3.5" : "3.6"));
-        EXPECT_NEAR(pupil[2] - e.centre[2], e.radius, 1e-4);
+        EXPECT_GT(pupil[2] - e.centre[2], e.radius + 0.5);
+        EXPECT_LT(pupil[2] - e.centre[2], e.radius + 1.2);
+        const double iris_cos = std::cos(e.iris_angle);
         for (int v = e.vertices.first; v < e.vertices.end(); ++v) {
             EXPECT_EQ(f.parts[v], side == 0 ? VertexPart::EyeballLeft : VertexPart::EyeballRight);
-            EXPECT_NEAR(testing::distance(testing::to_vec(f.mesh.point(TriMesh::VertexHandle(v))), e.centre), e.radius, 1e-3);
+            const Vec3d p = testing::to_vec(f.mesh.point(TriMesh::VertexHandle(v)));
+            const double r = testing::distance(p, e.centre);
+            if ((p[2] - e.centre[2]) / r < iris_cos) {
+                EXPECT_NEAR(r, e.radius, 1e-3);
+            } else {
+                EXPECT_GE(r, e.radius - 1e-3);
+                EXPECT_LE(r, pupil[2] - e.centre[2] + 1e-3);
+            }
         }
         ASSERT_EQ(e.upper_margin.size(), e.lower_margin.size());
         ASSERT_GE(e.upper_margin.size(), 5u);
@@ -386,8 +397,10 @@ TEST(DefaultFace, EyeballsSitUnderOpenLidsAndPartsAreContiguous) {
         const auto up = f.mesh.point(TriMesh::VertexHandle(e.upper_margin[mid]));
         const auto lo = f.mesh.point(TriMesh::VertexHandle(e.lower_margin[mid]));
         EXPECT_GT(up[1] - lo[1], 8.0);
+        // ... and clear of the cornea's bulge beneath them.
         for (int v : e.upper_margin)
-            EXPECT_GE(testing::distance(testing::to_vec(f.mesh.point(TriMesh::VertexHandle(v))), e.centre), e.radius);
+            EXPECT_GE(testing::distance(testing::to_vec(f.mesh.point(TriMesh::VertexHandle(v))), e.centre),
+                      e.radius + 0.25);
     }
     // Every part is present and each is one contiguous run of vertices
     // (render splits the mesh by them).
@@ -600,10 +613,12 @@ TEST_F(BadFaceParams, MessagesNameTheFileAndKey) {
     } cases[] = {
         {replaced("\"radius\": 12.5,", "\"radius\": 12.5, \"radiuss\": 1,"),
          "expression: " + file + ": eyes.radiuss: expected a known key (centre, radius, iris_radius, pupil_radius, "
-                                "inner_corner, outer_corner, upper_lid_height, lower_lid_height, upper_lid_peak, "
+                                "cornea, inner_corner, outer_corner, upper_lid_height, lower_lid_height, upper_lid_peak, "
                                 "lower_lid_peak, lid_clearance, lid_thickness, lid_blend_inner, lid_blend_outer, "
                                 "lid_warp_reach, sclera_corner_tint, sclera_vessels, lid_shadow, upper_lashes, lower_lashes), found \"radiuss\""},
         {replaced("\"iris_radius\": 5.9,", ""), "expression: " + file + ": eyes.iris_radius: expected a value, found no such key"},
+        {replaced("\"cornea\": {\"radius\": 7.8,", "\"cornea\": {\"radius\": 13,"),
+         "expression: " + file + ": eyes.cornea.radius: expected a number in [5, 12], found 13"},
         {replaced("\"centre_y\": -69,", "\"centre_y\": \"low\","),
          "expression: " + file + ": mouth.centre_y: expected a number, found \"low\""},
         {replaced("\"texture_size\": 2048", "\"texture_size\": 9"),

@@ -146,7 +146,8 @@ struct SkinShading {
     float wet_f0 = 0.025f;
     float wet_broad_roughness = 0.45f;
     float wet_broad_weight = 0.1f;
-    float wet_tight_scale = 0.5f;  // the tight lobe's roughness, of the shininess's (Walter et al. 2007)
+    float wet_tight_scale = 1.5f;  // the tight lobe's roughness, of the shininess's (Walter et al. 2007)
+    float wet_sheen = 5.0f;        // the lights' reflections on wet parts: the soft boxes' radiance over a point light's
 
     // --- light rig (the key light is the draw's Light, tinted) ---
     glm::vec3 key_tint{1.06f, 0.98f, 0.88f};
@@ -173,7 +174,7 @@ struct SkinShading {
                albedo_bump_bias == o.albedo_bump_bias && hair_luminance == o.hair_luminance &&
                hair_wrap == o.hair_wrap && hair_roughness == o.hair_roughness && hair_sheen == o.hair_sheen &&
                wet_f0 == o.wet_f0 && wet_broad_roughness == o.wet_broad_roughness &&
-               wet_broad_weight == o.wet_broad_weight && wet_tight_scale == o.wet_tight_scale && fill == o.fill && rim == o.rim &&
+               wet_broad_weight == o.wet_broad_weight && wet_tight_scale == o.wet_tight_scale && wet_sheen == o.wet_sheen && fill == o.fill && rim == o.rim &&
                sky == o.sky && ground == o.ground && exposure == o.exposure &&
                tone_mapping == o.tone_mapping;
     }
