@@ -592,10 +592,13 @@ void FaceRig::build_cheek_masses(detail::GeodesicGraph& graph, double es) {
 // It glides by kGlide of the way into that plane, outward only (medially
 // and up the corner runs onto the lips and the cheek's front, which face
 // forward): fully, the sheet's edge 15 mm out creased (AU20 61 deg against
-// 39); at 0.35 the skin beside the corner rises 5.8 mm for the corner's
-// 8.3 mm out instead of 8.1 (rig_smoothness_test) and AU20's largest crease
-// is 41.5 deg (was 39.1).
-constexpr double kGlideReach = 0.8, kGlide = 0.35;
+// 39); at 0.35 the skin beside the corner rose 5.8 mm for the corner's
+// 8.3 mm out instead of 8.1, and the lower cheek below the corner still
+// bulged 4.7 mm out along its normal at 0.8 AU20, an uneven jaw in fear at
+// 512 px (blind review, session 9); at 0.6 the skin beside the corner rises
+// 4.3 mm (rig_smoothness_test), the lower cheek 3.0, and AU20's largest
+// crease is 49.8 deg.
+constexpr double kGlideReach = 0.8, kGlide = 0.6;
 
 void FaceRig::build_corner_glide(const Face& face) {
     for (int side = 0; side < 2; ++side) {

@@ -335,8 +335,9 @@ TEST(RigSmoothness, RealFapFilesLeaveTheMouthCornersWhole) {
 // lift it off the face into a lump (issue 11: "rubber bulges beside the
 // mouth corners"). Measured as the largest motion along the neutral skin
 // normal of the skin 3 to 15 mm from the outer corner, against the corner's
-// own outward motion (8.3 mm): 8.1 mm (0.98) when the corner moved along x
-// alone, 5.8 mm (0.70) with the glide (rig.cpp, kGlide).
+// own outward motion (8.2 mm): 8.1 mm (0.98) when the corner moved along x
+// alone, 5.8 mm (0.70) with the glide at 0.35, 4.3 mm (0.52) at 0.6 (rig.cpp,
+// kGlide; the lower face below the corner bulged in fear at 0.35).
 TEST(RigSmoothness, SkinBesideAStretchedMouthCornerSlidesRatherThanRises) {
     const Face& face = test_face();
     const SkinEdges& e = skin_edges();
@@ -363,7 +364,7 @@ TEST(RigSmoothness, SkinBesideAStretchedMouthCornerSlidesRatherThanRises) {
             rise = std::max(rise, dot(sub(to_vec(d.positions[v]), p0[v]), vn[v]) / norm(vn[v]));
         }
         std::printf("AU20 corner %s: %.1f mm out; the skin beside it rises at most %.1f mm\n", id, out, rise);
-        EXPECT_LT(rise, 0.75 * out) << id;
+        EXPECT_LT(rise, 0.6 * out) << id;
     }
 }
 

@@ -115,13 +115,13 @@ TEST_P(EachFap, MovesItsFeaturePointAlongTheTableDirectionAndNothingFar) {
         Vec3d across = moved;
         for (int c = 0; c < 3; ++c) across[c] -= along * info.direction[c];
         // Lids slide over the eyeball, which moves them in z as well; a
-        // stretched mouth corner glides back round the teeth, 0.35 of its
+        // stretched mouth corner glides back round the teeth, 0.6 of its
         // outward move into the plane of the skin beside it (rig.cpp,
         // build_corner_glide), and a rising cheek comes forward over the
         // bone a little (rig.cpp, kMassForward).
         double allowed = 0.05;
         if (f >= 19 && f <= 22) allowed = 0.7;
-        if (f == 6 || f == 7 || f == 53 || f == 54) allowed = 0.4;
+        if (f == 6 || f == 7 || f == 53 || f == 54) allowed = 0.7;
         if (f == 41 || f == 42) allowed = 0.07;
         EXPECT_LT(norm(across), allowed * std::abs(expected) + 1e-4);
     }
