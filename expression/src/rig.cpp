@@ -403,13 +403,7 @@ void FaceRig::build_point_field(const Face& face, double radius_scale) {
         cheek_mass_.push_back({-1, -1, 0.0});
         return static_cast<int>(lid_fps_.size()) - 1;
     };
-    // The shield fades out over kShieldReach lid fades above the margin, past
-    // the lid fold: a brow that moves (AU1+AU4 in sadness, AU1+2+4 in fear)
-    // then turns the skin between the fold and the brow over a wider band.
-    // Ending it at 1.2 fades packed that turn into a few millimetres just
-    // over the fold, a steep slope facing down into the key light's shade:
-    // a dark band over the upper lid (blind review, issue 11).
-    constexpr double kBrowShield = 0.9, kShieldReach = 1.8;
+    constexpr double kBrowShield = 0.9;
     std::vector<double> brow_shield(n, 0.0);
     for (int k = 0; k < fap::kFeaturePointCount; ++k) {
         const auto id = fap::feature_points()[k].id;
@@ -441,7 +435,7 @@ void FaceRig::build_point_field(const Face& face, double radius_scale) {
             if (w > 1e-5) lid_weights_.push_back({v, lid, static_cast<float>(v == src ? 1.0 : w)});
             if (upper)
                 brow_shield[v] = std::max(brow_shield[v], kBrowShield * std::min(opening(x) / o_fp, 1.0) *
-                                                              raised_cosine(std::max(h, 0.0) / (kShieldReach * fade)));
+                                                              raised_cosine(std::max(h, 0.0) / (1.2 * fade)));
         }
         if (!upper) {
             // As the lower margin rises (AU6, AU7), the skin below it
