@@ -802,7 +802,7 @@ void FaceRig::point_displacements(const FapValues& faps, std::array<std::array<d
         for (const char* id : ids) {
             auto& p = d[fap::feature_point_index(id)];
             const double out = side == 0 ? std::max(p[0], 0.0) : std::min(p[0], 0.0);
-            p[2] = -kGlide * nrm[0] * out / nrm[2];
+            p[2] -= kGlide * nrm[0] * out / nrm[2];
         }
     }
     // A mouth corner's inner and outer points (2.4 and 8.3) are one corner
