@@ -5,6 +5,7 @@
 #include <limits>
 
 #include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
 
 #include "emoface/common/error.h"
 #include "emoface/common/parallel.h"
@@ -35,6 +36,16 @@ Frame frame_of(const glm::vec3& d) {
     return {u, glm::cross(d, u), d};
 }
 
+// Point i of n on the cap of half-angle `cos_max` (its cosine) around the
+// frame's axis, evenly spread by area (a Fibonacci spiral).
+glm::vec3 cap_direction(int i, int n, float cos_max, const Frame& axis) {
+    const float golden = 2.39996323f;
+    const float z = 1.0f - (1.0f - cos_max) * (float(i) + 0.5f) / float(n);
+    const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+    const float phi = golden * float(i);
+    return glm::normalize(r * std::cos(phi) * axis.u + r * std::sin(phi) * axis.w + z * axis.d);
+}
+
 }  // namespace
 
 std::vector<float> bake_vertex_occlusion(const std::vector<glm::vec3>& positions,
@@ -51,6 +62,13 @@ std::vector<float> bake_vertex_occlusion(const std::vector<glm::vec3>& positions
     if (!(spec.texel_mm > 0.0f) || spec.directions < 1 || !(spec.far_mm > spec.near_mm))
         fail("render: bake_vertex_occlusion: expected texel_mm > 0, directions >= 1, far_mm > near_mm; "
              "found {}, {}, {} <= {}", spec.texel_mm, spec.directions, spec.far_mm, spec.near_mm);
+    const bool cone = glm::length(spec.cone_axis) > 0.0f;
+    if (cone && !(spec.cone_half_angle_deg >= 0.0f && spec.cone_half_angle_deg < 90.0f))
+        fail("render: bake_vertex_occlusion: a light's cone of {} degrees, expected 0 to 90",
+             spec.cone_half_angle_deg);
+    const Frame cone_frame = frame_of(cone ? glm::normalize(spec.cone_axis) : glm::vec3(0, 0, 1));
+    const float cone_cos = std::cos(glm::radians(spec.cone_half_angle_deg));
+    const float up_weight = cone ? 0.0f : spec.up_weight;
     std::vector<float> open(n, 1.0f);
     if (n == 0 || triangles.empty()) return open;
 
@@ -90,7 +108,7 @@ std::vector<float> bake_vertex_occlusion(const std::vector<glm::vec3>& positions
                 sum_blocked.assign(n, 0.0f);
                 sum_seen.assign(n, 0.0f);
             }
-            const Frame f = frame_of(lattice_direction(dir, k));
+            const Frame f = frame_of(cone ? cap_direction(dir, k, cone_cos, cone_frame) : lattice_direction(dir, k));
             const float ox = glm::dot(centre, f.u) - radius, oy = glm::dot(centre, f.w) - radius;
             for (std::size_t i = 0; i < n; ++i)
                 q[i] = {(glm::dot(positions[i], f.u) - ox) * inv_texel,
@@ -129,7 +147,7 @@ std::vector<float> bake_vertex_occlusion(const std::vector<glm::vec3>& positions
                 // hemisphere).
                 const float cos_theta = glm::dot(unit[i], f.d);
                 if (cos_theta < kMinCos) continue;
-                const float weight = cos_theta * (1.0f + spec.up_weight * f.d.y);
+                const float weight = cos_theta * (1.0f + up_weight * f.d.y);
                 sum_seen[i] += weight;
                 // Looked up from a little above the surface, so that its
                 // own facets in the texel do not count.

@@ -83,9 +83,10 @@ float orbit_weight(const glm::vec3& p, const std::vector<glm::vec3>& upper, cons
     return across * std::min(up + down, 1.0f) * front;
 }
 
-}  // namespace
-
-std::vector<float> bake_face_occlusion(const expression::TriMesh& mesh, const expression::Face& face) {
+// The bake of bake_face_occlusion (`spec` its directions; `interior_bake`:
+// the mouth interior's own bake, else it is left open).
+std::vector<float> bake_face(const expression::TriMesh& mesh, const expression::Face& face, const OcclusionSpec& spec,
+                             bool interior_bake) {
     const std::size_t n = mesh.n_vertices();
     std::vector<glm::vec3> positions(n), normals(n);
     for (const auto vh : mesh.vertices()) {
@@ -111,7 +112,7 @@ std::vector<float> bake_face_occlusion(const expression::TriMesh& mesh, const ex
             if (!strand[t / 3]) solid.insert(solid.end(), triangles.begin() + std::ptrdiff_t(t), triangles.begin() + std::ptrdiff_t(t + 3));
         triangles.swap(solid);
     }
-    std::vector<float> open = bake_vertex_occlusion(positions, normals, triangles);
+    std::vector<float> open = bake_vertex_occlusion(positions, normals, triangles, spec);
 
     const bool parts_known = face.parts.size() == n;
     auto interior = [&](unsigned v) {
@@ -223,11 +224,12 @@ std::vector<float> bake_face_occlusion(const expression::TriMesh& mesh, const ex
     if (any) {
         const std::vector<float> lips_open =
             bake_subset(near, [&](unsigned a, unsigned b, unsigned c) { return lip[a] + lip[b] + lip[c] < 0.3f; },
-                        OcclusionSpec{});
+                        spec);
         for (std::size_t v = 0; v < n; ++v)
             if (lip[v] > 0.0f) open[v] = glm::mix(open[v], std::max(open[v], lips_open[v]), lip[v]);
     }
 
+    if (!interior_bake) return open;
     std::vector<char> inside(n, 0);
     bool any_inside = false;
     for (std::size_t v = 0; v < n; ++v) any_inside = (inside[v] = char(interior(unsigned(v)))) || any_inside;
@@ -256,6 +258,21 @@ std::vector<float> bake_face_occlusion(const expression::TriMesh& mesh, const ex
             }
     }
     return open;
+}
+
+}  // namespace
+
+std::vector<float> bake_face_occlusion(const expression::TriMesh& mesh, const expression::Face& face) {
+    return bake_face(mesh, face, OcclusionSpec{}, true);
+}
+
+std::vector<float> bake_face_light_visibility(const expression::TriMesh& mesh, const expression::Face& face,
+                                              const glm::vec3& toward_light, float half_angle_deg, int samples) {
+    OcclusionSpec spec;
+    spec.cone_axis = toward_light;
+    spec.cone_half_angle_deg = half_angle_deg;
+    spec.directions = samples;
+    return bake_face(mesh, face, spec, false);
 }
 
 }  // namespace emoface::render

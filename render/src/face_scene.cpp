@@ -218,6 +218,16 @@ FaceScene::FaceScene(Platform& platform, const expression::Face& face,
     // mouth interior take it (the eyeballs turn away from the rest shape's
     // occluders, so they keep their own shading).
     const std::vector<float> occlusion = bake_face_occlusion(mesh_, face);
+    // The portrait key's cast shadows on the rest shape, for the skin. The
+    // key stands for a soft box about 10 degrees in radius (its shadows'
+    // edges blur over a few mm at the nose's and the brows' distance), seen
+    // from 12 directions; the renderer draws them while the key stays near
+    // this direction (renderer.h, set_key_shadow).
+    constexpr float kKeyRadiusDeg = 10.0f;
+    constexpr int kKeySamples = 12;
+    const glm::vec3 toward_key = glm::normalize(glm::vec3(portrait_light().position));
+    const std::vector<float> key_visible =
+        bake_face_light_visibility(mesh_, face, toward_key, kKeyRadiusDeg, kKeySamples);
     const Material* materials[kGroups] = {&options.skin, &options.eyes, &options.mouth};
     for (int g = 0; g < kGroups; ++g) {
         Part& part = parts_[g];
@@ -251,10 +261,13 @@ FaceScene::FaceScene(Platform& platform, const expression::Face& face,
         part.fixed_tangents.assign(part.full_index.size(), glm::vec4(1, 0, 0, 1));
         part.id = renderer_->add_mesh(part.mesh, m);
         if (g != kEyes) {
-            std::vector<float> part_occlusion(part.full_index.size());
-            for (std::size_t i = 0; i < part.full_index.size(); ++i)
-                part_occlusion[i] = occlusion[std::size_t(part.full_index[i])];
-            renderer_->set_occlusion(part.id, part_occlusion);
+            auto of_part = [&](const std::vector<float>& whole) {
+                std::vector<float> values(part.full_index.size());
+                for (std::size_t i = 0; i < values.size(); ++i) values[i] = whole[std::size_t(part.full_index[i])];
+                return values;
+            };
+            renderer_->set_occlusion(part.id, of_part(occlusion));
+            renderer_->set_key_shadow(part.id, of_part(key_visible), toward_key);
         }
         // Parts the CPU gives no frames to: constant ones, uploaded once.
         if (!part.wrinkles || frames_ == WrinkleFrames::Shader)

@@ -9,6 +9,7 @@
 #include <glm/gtc/matrix_inverse.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
+#include <glm/trigonometric.hpp>
 
 #include "emoface/render/platform.h"
 #include "emoface/render/wrinkle_texture.h"
@@ -192,8 +193,21 @@ struct DetailMap {
     GLuint texture = 0;
     float slope_scale = 0.0f;  // the slope a channel's 1 stands for
 };
-DetailMap upload_detail_map(const ImageRGBA8& image, float mean_levels, std::array<float, 2> hair_luminance) {
+// `key_visible` (per vertex of `uvs` and `triangles`; empty: 1) goes into
+// the alpha: the key's baked shadows (Renderer::set_key_shadow), read with
+// the relief at no further cost to the draw (a vertex attribute of its own
+// cost the H100's draw 0.04 ms: docs/PERFORMANCE.md, session 10).
+DetailMap upload_detail_map(const ImageRGBA8& image, float mean_levels, std::array<float, 2> hair_luminance,
+                            const std::vector<float>& key_visible, const std::vector<glm::vec2>& uvs,
+                            const std::vector<std::uint32_t>& triangles) {
     const std::vector<float> slopes = detail::albedo_detail_slopes(image, mean_levels, hair_luminance);
+    // Grown 4 texels past the UV islands' edges: the gutters the look-ups
+    // of the next mip levels blend in.
+    constexpr int kGrowTexels = 4;
+    const std::vector<float> alpha =
+        key_visible.empty() ? std::vector<float>()
+                            : detail::vertex_values_in_uv(uvs, triangles, key_visible, image.width, image.height,
+                                                          kGrowTexels, 1.0f);
     float scale = 0.0f;
     for (std::size_t i = 0; i < slopes.size(); i += 3)
         scale = std::max({scale, std::abs(slopes[i]), std::abs(slopes[i + 1])});
@@ -204,7 +218,7 @@ DetailMap upload_detail_map(const ImageRGBA8& image, float mean_levels, std::arr
         texels[j] = unorm(0.5f + 0.5f * slopes[i] / scale);
         texels[j + 1] = unorm(0.5f + 0.5f * slopes[i + 1] / scale);
         texels[j + 2] = unorm(slopes[i + 2]);
-        texels[j + 3] = 255;
+        texels[j + 3] = alpha.empty() ? 255 : unorm(alpha[i / 3]);
     }
     return {upload_texture({GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, 1, true, GL_CLAMP_TO_EDGE,
                             "uploading a base texture's relief"},
@@ -234,6 +248,23 @@ GLuint upload_pore_map(const PoreMapSpec& spec) {
                           spec.size, spec.size, texels.data());
 }
 
+// How far the key's baked shadows stand for its shadows in this draw: 1
+// while the key shines from within fade[0] degrees of the direction they
+// were baked for (`toward`, model space; zero: none baked), fading to 0 at
+// fade[1], where the contact shadow from the ambient occlusion takes over.
+float baked_key_weight(const DrawOptions& o, const glm::vec3& toward) {
+    if (!(glm::length(toward) > 0.0f)) return 0.0f;
+    const glm::vec3 p = glm::vec3(o.light.position);
+    const glm::vec3 key = o.light.position.w == 0.0f ? p : p - glm::vec3(o.model[3]);
+    if (!(glm::length(key) > 0.0f)) return 0.0f;
+    const float c = glm::dot(glm::normalize(key), glm::normalize(glm::mat3(o.model) * toward));
+    const float near = std::cos(glm::radians(o.skin.key_shadow_fade_deg[0]));
+    const float far = std::cos(glm::radians(o.skin.key_shadow_fade_deg[1]));
+    if (!(near > far)) return c >= near ? 1.0f : 0.0f;
+    const float t = std::clamp((c - far) / (near - far), 0.0f, 1.0f);
+    return t * t * (3.0f - 2.0f * t);
+}
+
 }  // namespace
 
 struct Renderer::Impl {
@@ -248,6 +279,12 @@ struct Renderer::Impl {
         std::array<float, 2> detail_hair{};  // the hair mask's luminance range it was made with
         GLuint vao = 0, shape_vbo = 0, frame_vbo = 0, static_vbo = 0, ebo = 0;
         GLuint occlusion_vbo = 0;  // attribute 5; none: the constant 1 (open)
+        // The key's baked visibility per vertex (set_key_shadow), drawn
+        // into the detail map's alpha; the key's direction it was baked for
+        // (model space; zero: none).
+        std::vector<float> key_visible;
+        glm::vec3 key_shadow_toward{0.0f};
+        std::vector<std::uint32_t> triangles;  // kept for painting key_visible into the base UVs
         GLsizei index_count = 0;
         std::size_t vertex_count = 0;
         std::vector<glm::vec2> base_uvs;
@@ -269,7 +306,7 @@ struct Renderer::Impl {
             light_diffuse, light_specular, specular_color, shininess, camera_position, projective,
             box, skin_model, skin_surface, scatter_table, max_curvature, mm_per_unit,
             normal_softening, cavity_direct, pore_map, pore_tiles, pore_strength, detail_map, albedo_bump, f0, roughness,
-            lobe_weight, gloss_exponent, sheen_intensity, occlusion, key_cone, min_curvature, wrap, hair, wet, wet_sheen, key_tint,
+            lobe_weight, gloss_exponent, sheen_intensity, occlusion, key_cone, key_shadow, min_curvature, wrap, hair, wet, wet_sheen, key_tint,
             fill_direction, fill_colour, rim_direction, rim_colour, sky, ground,
             exposure, tone_map;
     } loc{};
@@ -369,6 +406,7 @@ Renderer::Renderer(Platform& platform) : impl_(std::make_unique<Impl>(platform))
     l.gloss_exponent = u("u_gloss_exponent");
     l.sheen_intensity = u("u_sheen_intensity");
     l.occlusion = u("u_occlusion");
+    l.key_shadow = u("u_key_shadow");
     l.key_cone = u("u_key_cone");
     l.min_curvature = u("u_min_curvature");
     l.wrap = u("u_wrap");
@@ -429,6 +467,7 @@ Renderer::MeshId Renderer::add_mesh(const expression::TriMesh& mesh, const Mater
     }
     if (impl_->front_first) order_front_first(mesh, indices);
     m.index_count = GLsizei(indices.size());
+    m.triangles = indices;
     m.base_uvs.assign(m.vertex_count, glm::vec2(0.0f));
     if (mesh.has_vertex_texcoords2D())
         for (const auto vh : mesh.vertices()) {
@@ -510,6 +549,21 @@ void Renderer::set_occlusion(MeshId id, const std::vector<float>& occlusion) {
     glBindVertexArray(0);
     glBindBuffer(GL_ARRAY_BUFFER, 0);
     check_gl("Renderer::set_occlusion(): uploading the occlusion");
+}
+
+void Renderer::set_key_shadow(MeshId id, const std::vector<float>& visibility, const glm::vec3& toward_key) {
+    impl_->platform.make_current();
+    Impl::Mesh& m = impl_->mesh(id);
+    if (visibility.size() != m.vertex_count)
+        fail("render: Renderer::set_key_shadow(): {} values for mesh {} of {} vertices, expected one each",
+             visibility.size(), id, m.vertex_count);
+    if (!(glm::length(toward_key) > 0.0f))
+        fail("render: Renderer::set_key_shadow(): a zero direction to the key, expected a unit vector");
+    m.key_visible = visibility;
+    m.key_shadow_toward = glm::normalize(toward_key);
+    // The detail map carries it: made again at the next skin draw.
+    if (m.detail_texture) glDeleteTextures(1, &m.detail_texture);
+    m.detail_texture = 0;
 }
 
 void Renderer::update_mesh(MeshId id, const expression::TriMesh& mesh,
@@ -643,7 +697,8 @@ void Renderer::draw(const DrawOptions& o, const WrinkleTexture* wrinkle_map) {
             if (!wanted || (m.detail_texture && m.detail_levels == k.albedo_bump_bias &&
                             m.detail_hair == k.hair_luminance))
                 continue;
-            const DetailMap d = upload_detail_map(*m.material.base_texture, k.albedo_bump_bias, k.hair_luminance);
+            const DetailMap d = upload_detail_map(*m.material.base_texture, k.albedo_bump_bias, k.hair_luminance,
+                                                  m.key_visible, m.base_uvs, m.triangles);
             if (m.detail_texture) glDeleteTextures(1, &m.detail_texture);
             m.detail_texture = d.texture;
             m.detail_slope_scale = d.slope_scale;
@@ -689,6 +744,12 @@ void Renderer::draw(const DrawOptions& o, const WrinkleTexture* wrinkle_map) {
         glActiveTexture(GL_TEXTURE0);
         glBindTexture(GL_TEXTURE_2D, m.base_texture);
         if (!m.occlusion_vbo) glVertexAttrib1f(5, 1.0f);
+        if (skin_model) {
+            // Drawn from the detail map's alpha: without the map, none.
+            const bool read = m.detail_texture && albedo_bump > 0.0f && m.material.uses_wrinkle_map;
+            const glm::vec3 toward = read ? m.key_shadow_toward : glm::vec3(0.0f);
+            glUniform2f(im.loc.key_shadow, baked_key_weight(o, toward), o.skin.key_shadow);
+        }
         glBindVertexArray(m.vao);
         glDrawElements(GL_TRIANGLES, m.index_count, GL_UNSIGNED_INT, nullptr);
     }

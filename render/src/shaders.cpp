@@ -101,7 +101,8 @@ uniform float u_cavity_direct;
 uniform sampler2D u_pore_map;       // rgb normal, a cavity
 uniform float u_pore_tiles;
 uniform float u_pore_strength;
-uniform sampler2D u_detail_map;     // rg: the base colour's relief, 0.5 + 0.5 slope per base UV; b: hair (skin_maps.h)
+uniform sampler2D u_detail_map;     // rg: the base colour's relief, 0.5 + 0.5 slope per base UV; b: hair (skin_maps.h);
+                                    // a: the share of the key the rest shape gets (its baked shadows)
 uniform float u_albedo_bump;        // detail height (scene units) per unit of the relief, x the map's slope scale
 uniform float u_f0;
 uniform vec2 u_roughness;
@@ -110,6 +111,7 @@ uniform float u_gloss_exponent;     // roughness x gloss^this (gloss: the base m
 uniform vec2 u_sheen_intensity;     // direct sheen at gloss 1 (matte), gloss at which it is full
 uniform vec3 u_occlusion;           // how far the baked occlusion dims: key, fill/rim/sky diffuse, specular
 uniform vec2 u_key_cone;            // the key's contact shadow: the open cone's lean, its narrowest cos
+uniform vec2 u_key_shadow;          // the baked cast shadow: how far it stands (1: the key is where it was baked), its depth
 uniform float u_min_curvature;      // table coordinate: the flattest skin still scatters
 uniform float u_wrap;               // the rig lights' softness (wrapped N.L, energy kept)
 uniform vec3 u_hair;                // hair: wrap, roughness, the lights' sheen
@@ -194,6 +196,7 @@ struct Surface {
     float cavity;    // 1 open skin, 0 a deep crevice
     float direct_sheen;   // the region's scale of the lights' sheen
     float key_cone;       // the key's contact shadow: cos of the open cone's half-angle
+    float key_visible;    // the baked share of the key that reaches the rest shape
     float dim_shadow;     // ... of the fill's, the rim's and the sky's
     float dim_sheen;      // specular occlusion of the fill, the rim and the sky
 };
@@ -215,20 +218,28 @@ struct Surface {
 // past 90 degrees and softens; nothing is added).
 vec3 shade_light(Surface s, vec3 l, vec3 c, const bool full, const bool glossy) {
     vec3 diffuse;
-    // The key's contact shadow, from the baked occlusion ao: a point open to
-    // a cone of half-angle t has ao = sin^2 t (cosine weighted), so it sees
-    // the key only where the cone's axis . L > cos t. On a face most
-    // occluders lie above (brows over the eyes, the nose over the lip, the
-    // jaw over the neck), so the axis leans down from the normal by
-    // u_key_cone.x (1 - ao) (unnormalised: the lean's dot with L). The
-    // occlusion is baked on the rest shape, stale where the face moves (a
-    // raised lid bares skin that was inside its fold): the cone is never
-    // narrower than u_key_cone.y, so skin facing the key is lit. Soft over
-    // 0.3 (the key is a soft box); u_occlusion.x of it applies.
+    // The key's shadows. Baked for the key where it stands by default
+    // (face_occlusion.h: its cast shadows on the rest shape, the nose's on
+    // the cheek and lip, the brows' in the sockets, the jaw's on the neck):
+    // u_key_shadow.x is 1 there, fading to 0 as the key moves away from it
+    // (the viewer's light), where a contact shadow from the baked ambient
+    // occlusion ao stands in: a point open to a cone of half-angle t has
+    // ao = sin^2 t (cosine weighted), so it sees the key only where the
+    // cone's axis . L > cos t. On a face most occluders lie above (brows
+    // over the eyes, the nose over the lip, the jaw over the neck), so the
+    // axis leans down from the normal by u_key_cone.x (1 - ao)
+    // (unnormalised: the lean's dot with L). Both are of the rest shape,
+    // stale where the face moves (a raised lid bares skin that was inside
+    // its fold): the cone is never narrower than u_key_cone.y, so skin
+    // facing the key is lit. Soft over 0.3 (the key is a soft box);
+    // u_occlusion.x of it applies.
     float visible = 1.0;
     if (full && u_skin_surface) {
-        float toward = dot(s.n_g, l) - u_key_cone.x * s.key_cone * s.key_cone * l.y;
-        visible = mix(1.0, smoothstep(s.key_cone - 0.3, s.key_cone, toward), u_occlusion.x);
+        if (u_key_shadow.x < 1.0) {
+            float toward = dot(s.n_g, l) - u_key_cone.x * s.key_cone * s.key_cone * l.y;
+            visible = mix(1.0, smoothstep(s.key_cone - 0.3, s.key_cone, toward), u_occlusion.x);
+        }
+        visible = mix(visible, 1.0 - u_key_shadow.y * (1.0 - s.key_visible), u_key_shadow.x);
     }
     if (u_skin_surface) {
         float wrap_scale = 1.0 / (1.0 + u_wrap);
@@ -279,7 +290,10 @@ vec3 shade_light(Surface s, vec3 l, vec3 c, const bool full, const bool glossy) 
 // `hair`: 1 on the scalp's hair and the brows (the relief map's third
 // channel), whose diffuse light is plain and whose sheen is one broad, dim
 // lobe.
-vec3 shade_skin(vec3 n_bumped, vec3 n_geo, vec3 base, float cavity, float gloss, vec2 slope, float hair) {
+// `key_visible`: the share of the key that reaches the rest shape there (the
+// detail map's alpha; 1 without it).
+vec3 shade_skin(vec3 n_bumped, vec3 n_geo, vec3 base, float cavity, float gloss, vec2 slope, float hair,
+                float key_visible) {
     Surface s;
     s.v = normalize(u_camera_position - v_position);
     s.cavity = cavity;
@@ -367,11 +381,11 @@ vec3 shade_skin(vec3 n_bumped, vec3 n_geo, vec3 base, float cavity, float gloss,
     // The baked occlusion (eye sockets, nostrils, mouth corners, under the
     // jaw, the ears, the hairline) stands for the shadows the rig's broad
     // lights would cast there: fully for the sky, mostly for the fill and
-    // the rim, and for the key where it grazes (shade_light; its shadows
-    // are not drawn). With the
-    // wrinkle and pore cavity it also fades the sheen (Lagarde & de
-    // Rousiers 2014).
+    // the rim, and for the key where it grazes when the key is off the
+    // direction its shadows were baked for (shade_light). With the wrinkle
+    // and pore cavity it also fades the sheen (Lagarde & de Rousiers 2014).
     s.key_cone = min(sqrt(max(1.0 - occlusion, 0.0)), u_key_cone.y);
+    s.key_visible = key_visible;
     s.dim_shadow = mix(1.0, occlusion, u_occlusion.y);
     float ambient_open = s.cavity * mix(1.0, occlusion, u_occlusion.z);
     s.dim_sheen = specular_occlusion(s.n_dot_v, ambient_open, mean_roughness);
@@ -415,21 +429,23 @@ void main() {
     float gloss = 1.0;
     vec2 slope = vec2(0.0);
     float hair = 0.0;
+    float key_visible = 1.0;
     if (u_has_base_map) {
         vec4 texel = texture(u_base_map, v_base_uv);
         base *= texel.rgb;
         if (u_skin_model) {
             gloss = texel.a;
             if (u_skin_surface && u_albedo_bump > 0.0) {
-                vec3 detail = texture(u_detail_map, v_base_uv).rgb;
+                vec4 detail = texture(u_detail_map, v_base_uv);
                 slope = (u_albedo_bump / u_pore_tiles) * (detail.rg * 2.0 - 1.0);
                 hair = detail.b;
+                key_visible = detail.a;
             }
         }
     }
 
     if (u_skin_model) {
-        vec3 color = u_exposure * shade_skin(n, n_geo, base, cavity, gloss, slope, hair);
+        vec3 color = u_exposure * shade_skin(n, n_geo, base, cavity, gloss, slope, hair, key_visible);
         frag_color = vec4(srgb_encode(u_tone_map ? tone_map(color) : color), 1.0);
         return;
     }

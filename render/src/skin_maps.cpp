@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "emoface/common/constants.h"
 #include "emoface/common/error.h"
@@ -258,6 +259,86 @@ std::vector<float> albedo_detail_slopes(const ImageRGBA8& image, float mean_leve
             out[3 * i + 1] = float(fade * 0.5 * (at(x, r + 1) - at(x, r - 1)) * h);
             out[3 * i + 2] = float(hair[i]);
         }
+    return out;
+}
+
+std::vector<float> vertex_values_in_uv(const std::vector<glm::vec2>& uvs, const std::vector<unsigned>& triangles,
+                                       const std::vector<float>& values, int width, int height, int dilate,
+                                       float empty) {
+    if (values.size() != uvs.size())
+        fail("render: vertex_values_in_uv: {} values for {} vertices, expected one each", values.size(), uvs.size());
+    if (triangles.size() % 3 != 0)
+        fail("render: vertex_values_in_uv: {} triangle indices, expected a multiple of 3", triangles.size());
+    if (width < 1 || height < 1 || dilate < 0)
+        fail("render: vertex_values_in_uv: a {}x{} map grown {} texels, expected a positive size", width, height,
+             dilate);
+    for (unsigned i : triangles)
+        if (i >= uvs.size()) fail("render: vertex_values_in_uv: triangle index {}, expected < {}", i, uvs.size());
+    const std::size_t texels = std::size_t(width) * std::size_t(height);
+    std::vector<float> out(texels, 0.0f);
+    std::vector<char> painted(texels, 0);
+    for (std::size_t t = 0; t < triangles.size(); t += 3) {
+        glm::vec2 q[3];
+        float v[3];
+        for (int k = 0; k < 3; ++k) {
+            const unsigned i = triangles[t + std::size_t(k)];
+            q[k] = {uvs[i].x * float(width), uvs[i].y * float(height)};
+            v[k] = values[i];
+        }
+        const float area = (q[1].x - q[0].x) * (q[2].y - q[0].y) - (q[1].y - q[0].y) * (q[2].x - q[0].x);
+        if (std::abs(area) < 1e-12f) continue;
+        const float inv_area = 1.0f / area;
+        const int x0 = std::max(0, int(std::ceil(std::min({q[0].x, q[1].x, q[2].x}) - 0.5f)));
+        const int x1 = std::min(width - 1, int(std::floor(std::max({q[0].x, q[1].x, q[2].x}) - 0.5f)));
+        const int y0 = std::max(0, int(std::ceil(std::min({q[0].y, q[1].y, q[2].y}) - 0.5f)));
+        const int y1 = std::min(height - 1, int(std::floor(std::max({q[0].y, q[1].y, q[2].y}) - 0.5f)));
+        for (int y = y0; y <= y1; ++y)
+            for (int x = x0; x <= x1; ++x) {
+                const float px = float(x) + 0.5f, py = float(y) + 0.5f;
+                const float w1 = ((px - q[0].x) * (q[2].y - q[0].y) - (py - q[0].y) * (q[2].x - q[0].x)) * inv_area;
+                const float w2 = ((q[1].x - q[0].x) * (py - q[0].y) - (q[1].y - q[0].y) * (px - q[0].x)) * inv_area;
+                const float w0 = 1.0f - w1 - w2;
+                if (w0 < -1e-5f || w1 < -1e-5f || w2 < -1e-5f) continue;
+                const std::size_t at = std::size_t(y) * std::size_t(width) + std::size_t(x);
+                out[at] = w0 * v[0] + w1 * v[1] + w2 * v[2];
+                painted[at] = 1;
+            }
+    }
+    // Each step fills the empty texels beside painted ones, from the
+    // painted neighbours alone (so a step grows one texel, in every
+    // direction alike); only the empty texels are visited.
+    std::vector<std::size_t> gutter;
+    for (std::size_t i = 0; i < texels; ++i)
+        if (!painted[i]) gutter.push_back(i);
+    std::vector<std::pair<std::size_t, float>> filled;
+    for (int step = 0; step < dilate && !gutter.empty(); ++step) {
+        filled.clear();
+        std::size_t kept = 0;
+        for (const std::size_t at : gutter) {
+            const int x = int(at % std::size_t(width)), y = int(at / std::size_t(width));
+            float sum = 0.0f;
+            int count = 0;
+            for (int ny = std::max(y - 1, 0); ny <= std::min(y + 1, height - 1); ++ny)
+                for (int nx = std::max(x - 1, 0); nx <= std::min(x + 1, width - 1); ++nx) {
+                    const std::size_t n = std::size_t(ny) * std::size_t(width) + std::size_t(nx);
+                    if (painted[n]) {
+                        sum += out[n];
+                        ++count;
+                    }
+                }
+            if (count > 0)
+                filled.emplace_back(at, sum / float(count));
+            else
+                gutter[kept++] = at;
+        }
+        gutter.resize(kept);
+        for (const auto& [at, value] : filled) {
+            out[at] = value;
+            painted[at] = 1;
+        }
+    }
+    for (std::size_t i = 0; i < texels; ++i)
+        if (!painted[i]) out[i] = empty;
     return out;
 }
 

@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <vector>
 
+#include <glm/vec2.hpp>
+
 #include "emoface/render/image.h"
 #include "emoface/render/skin_shading.h"
 
@@ -42,5 +44,15 @@ std::vector<std::uint8_t> pore_map(const PoreMapSpec& spec);
 // lines, lighter than the gaps between them, stand out.
 std::vector<float> albedo_detail_slopes(const ImageRGBA8& image, float mean_levels,
                                         std::array<float, 2> hair_luminance);
+
+// Per-vertex values painted into a texture of the base UVs (texel (x, y) at
+// ((x + 0.5) / width, (y + 0.5) / height), rows bottom first as above),
+// interpolated over each triangle; then grown `dilate` texels out past the
+// triangles' edges (each empty texel takes the mean of its painted
+// neighbours), so that bilinear filtering and mip levels by a UV seam see
+// the values and not the gutter; texels left over hold `empty`.
+std::vector<float> vertex_values_in_uv(const std::vector<glm::vec2>& uvs, const std::vector<unsigned>& triangles,
+                                       const std::vector<float>& values, int width, int height, int dilate,
+                                       float empty);
 
 }  // namespace emoface::render::detail

@@ -75,6 +75,11 @@ SkinShading load_skin_shading(const std::string& path) {
         s.occlusion_specular = float(occlusion.number_in("specular", 0.0, 1.0));
         s.occlusion_key_lean = float(occlusion.number_in("key_lean", 0.0, 4.0));
         s.occlusion_key_cone_max = float(occlusion.number_in("key_cone_max", 0.0, 1.0));
+        s.key_shadow = float(occlusion.number_in("key_shadow", 0.0, 1.0));
+        const auto fade = occlusion.numbers<2>("key_shadow_fade_deg");
+        if (!(fade[0] >= 0.0 && fade[0] < fade[1] && fade[1] <= 90.0))
+            occlusion.at("key_shadow_fade_deg").fail("an increasing pair of angles in [0, 90]");
+        for (int i = 0; i < 2; ++i) s.key_shadow_fade_deg[std::size_t(i)] = float(fade[std::size_t(i)]);
         occlusion.finish();
 
         JsonReader pores = root.object("pores");

@@ -95,12 +95,40 @@ TEST(AmbientOcclusion, SameResultEachCall) {
               bake_vertex_occlusion(s.positions, s.normals, s.triangles));
 }
 
+// A light's cone (OcclusionSpec::cone_axis): a wall 10 mm high along x = 5
+// shades the floor from a light beyond it at 45 degrees out to 10 mm from
+// its foot, and not at all from a light behind the floor.
+TEST(AmbientOcclusion, AWallCastsTheShadowOfALightBeyondItOnly) {
+    const Sheet s = height_field(25, [](float x, float) { return x > 5.0f ? 10.0f : 0.0f; });
+    auto visible = [&](glm::vec3 toward) {
+        OcclusionSpec spec;
+        spec.texel_mm = 0.5f;
+        spec.cone_axis = glm::normalize(toward);
+        spec.cone_half_angle_deg = 5.0f;
+        spec.directions = 16;
+        return bake_vertex_occlusion(s.positions, s.normals, s.triangles, spec);
+    };
+    const std::vector<float> beyond = visible({1, 0, 1}), behind = visible({-1, 0, 1});
+    const std::size_t foot = std::size_t(s.at(25 + 0, 25)), far = std::size_t(s.at(25 - 15, 25));
+    EXPECT_LT(beyond[foot], 0.1f);
+    EXPECT_GT(beyond[far], 0.9f);
+    EXPECT_GT(behind[foot], 0.9f);
+    // The wall's top sees both.
+    const std::size_t top = std::size_t(s.at(25 + 15, 25));
+    EXPECT_GT(beyond[top], 0.9f);
+    EXPECT_GT(behind[top], 0.9f);
+}
+
 TEST(AmbientOcclusion, BadInputIsAnError) {
     const Sheet s = height_field(2, [](float, float) { return 0.0f; });
     std::vector<unsigned> bad = s.triangles;
     bad.back() = unsigned(s.positions.size());
     EXPECT_THROW(bake_vertex_occlusion(s.positions, s.normals, bad), emoface::Error);
     EXPECT_THROW(bake_vertex_occlusion(s.positions, {}, s.triangles), emoface::Error);
+    OcclusionSpec wide;
+    wide.cone_axis = {0, 0, 1};
+    wide.cone_half_angle_deg = 95.0f;
+    EXPECT_THROW(bake_vertex_occlusion(s.positions, s.normals, s.triangles, wide), emoface::Error);
 }
 
 }  // namespace

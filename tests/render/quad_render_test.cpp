@@ -754,6 +754,41 @@ TEST_F(SkinQuad, KeyContactShadowFollowsTheOcclusionsCone) {
     EXPECT_NEAR(thesis_shut, thesis_open, 1e-6f) << "the thesis's Blinn-Phong has no occlusion";
 }
 
+// The key's baked cast shadow (Renderer::set_key_shadow): while the key
+// shines from where the shadow was baked, a point the bake saw in shadow
+// loses key_shadow of the key's light; a key 30 degrees away (past
+// key_shadow_fade_deg) ignores it, as does a point the bake saw lit.
+TEST_F(SkinQuad, BakedKeyShadowHoldsWhileTheKeyIsWhereItWasBaked) {
+    const SkinShading skin = dark_rig();
+    ASSERT_LT(skin.key_shadow_fade_deg[1], 30.0f);
+    Material m;
+    m.uses_wrinkle_map = true;  // a skin surface
+    m.base_color = glm::vec3(0.5f);
+    // The shadow is drawn from the base map's relief map (its alpha).
+    auto white = std::make_shared<ImageRGBA8>(8, 8);
+    std::fill(white->pixels.begin(), white->pixels.end(), std::uint8_t(255));
+    m.base_texture = white;
+    const std::size_t n = make_quad(UvLayout::VUp).n_vertices();
+    const glm::vec3 baked(0.0f, 0.0f, 1.0f), away(0.0f, std::sin(glm::radians(30.0f)), std::cos(glm::radians(30.0f)));
+    auto lit = [&](float visible, glm::vec3 towards) {
+        renderer_->set_key_shadow(white_, std::vector<float>(n, visible), baked);
+        return draw(m, 0.0f, directional(towards), skin).g;
+    };
+    const float open_baked = lit(1.0f, baked), shut_baked = lit(0.0f, baked);
+    const float open_away = lit(1.0f, away), shut_away = lit(0.0f, away);
+    // Without a base map there is no relief map to carry the shadow.
+    Material plain = m;
+    plain.base_texture = nullptr;
+    const float plain_shut = draw(plain, 0.0f, directional(baked), skin).g;
+    renderer_->set_key_shadow(white_, std::vector<float>(n, 1.0f), baked);  // the other tests' quad: lit
+    const float plain_open = draw(plain, 0.0f, directional(baked), skin).g;
+    ASSERT_GT(open_baked, 0.05f);
+    EXPECT_NEAR(shut_baked / open_baked, 1.0f - skin.key_shadow, 0.05f) << "in the baked shadow";
+    EXPECT_NEAR(shut_away / open_away, 1.0f, 0.02f) << "a key moved away ignores it";
+    EXPECT_NEAR(plain_shut, plain_open, 1e-6f);
+    EXPECT_THROW(renderer_->set_key_shadow(white_, std::vector<float>(n + 1, 1.0f), baked), emoface::Error);
+}
+
 // The dim lights (fill, rim) shade with wrapped Lambert instead of the
 // scattering table (shaders.cpp): that holds while the table's flattest row,
 // where most of the face is looked up, is Lambert.
@@ -780,6 +815,26 @@ TEST(SkinMaps, ScatterTablesFlattestRowIsLambert) {
 
 // The pore map (skin_maps.h): pits over a network of furrows that cross
 // (the skin's microrelief), tiling without a seam.
+// Vertex values painted into the base UVs (the key's baked shadow in the
+// relief map's alpha): interpolated across a triangle, grown a few texels
+// past its edge into the gutter, and `empty` beyond that.
+TEST(SkinMaps, VertexValuesArePaintedIntoTheirUvsAndGrownPastTheEdges) {
+    using emoface::render::detail::vertex_values_in_uv;
+    // One triangle over the lower-left half of a 16x16 map: 0 at u = 0, 1 at u = 1.
+    const std::vector<glm::vec2> uvs = {{0.0f, 0.0f}, {1.0f, 0.0f}, {0.0f, 1.0f}};
+    const std::vector<unsigned> triangle = {0, 1, 2};
+    const std::vector<float> values = {0.0f, 1.0f, 0.0f};
+    const std::vector<float> map = vertex_values_in_uv(uvs, triangle, values, 16, 16, 2, -1.0f);
+    ASSERT_EQ(map.size(), 256u);
+    auto at = [&](int x, int y) { return map[std::size_t(y) * 16 + std::size_t(x)]; };
+    EXPECT_NEAR(at(0, 0), 0.5f / 16.0f, 1e-5f);
+    EXPECT_NEAR(at(7, 3), 7.5f / 16.0f, 1e-5f);    // u = 7.5 / 16 inside
+    EXPECT_GT(at(8, 8), 0.0f) << "the texel past the diagonal is grown from its neighbours";
+    EXPECT_EQ(at(15, 15), -1.0f) << "far from the triangle: empty";
+    EXPECT_THROW(vertex_values_in_uv(uvs, triangle, {0.0f}, 16, 16, 2, 1.0f), emoface::Error);
+    EXPECT_THROW(vertex_values_in_uv(uvs, {0, 1, 3}, values, 16, 16, 2, 1.0f), emoface::Error);
+}
+
 TEST(SkinMaps, PoreMapIsPitsOverCrossingFurrowsAndTiles) {
     emoface::render::PoreMapSpec spec;
     const int n = spec.size;

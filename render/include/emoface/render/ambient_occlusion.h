@@ -34,6 +34,8 @@ struct OcclusionSpec {
     float near_mm = 120.0f;  // an occluder this close blocks fully
     float far_mm = 240.0f;   // ... and this far not at all
     float up_weight = 0.5f;  // directions weigh 1 + up_weight * y: the sky (+y) lights more than the ground
+    glm::vec3 cone_axis{0.0f};       // zero: the whole sphere; else towards a light (up_weight unused)
+    float cone_half_angle_deg = 0.0f;  // the light's angular radius
 };
 
 // One value per position; triangles index positions. Normals need not be

@@ -22,6 +22,8 @@
 // Eyeball vertices get the whole-head bake (the renderer leaves them open).
 #include <vector>
 
+#include <glm/vec3.hpp>
+
 #include "emoface/expression/face.h"
 
 namespace emoface::render {
@@ -30,5 +32,14 @@ namespace emoface::render {
 // mesh with vertex normals; a face without parts or lip feature points gets
 // the plain whole-mesh bake.
 std::vector<float> bake_face_occlusion(const expression::TriMesh& mesh, const expression::Face& face);
+
+// The share of a soft light that reaches each vertex of the rest shape: its
+// cast shadows (the nose's on the cheek and lip, the brow's in the socket,
+// the jaw's on the neck), the light seen as a disc of `half_angle_deg`
+// around `toward_light` (mesh space) from `samples` directions. The same
+// bake as above (the lashes cast nothing, the lids keep a share, the lips
+// see past each other), but for the mouth interior, left open (1).
+std::vector<float> bake_face_light_visibility(const expression::TriMesh& mesh, const expression::Face& face,
+                                              const glm::vec3& toward_light, float half_angle_deg, int samples);
 
 }  // namespace emoface::render

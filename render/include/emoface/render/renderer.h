@@ -160,6 +160,12 @@ public:
     // Static ambient occlusion, one value per vertex in [0, 1] (1 = open;
     // ambient_occlusion.h); skin shading only. Without it a mesh is open.
     void set_occlusion(MeshId id, const std::vector<float>& occlusion);
+    // The key light's cast shadows, baked on the rest shape: the share of
+    // the key that reaches each vertex (face_occlusion.h), for a key shining
+    // from `toward_key` (model space). Skin shading draws them while the
+    // draw's key is near that direction (SkinShading::key_shadow_fade_deg);
+    // otherwise, or without them, a contact shadow from the occlusion.
+    void set_key_shadow(MeshId id, const std::vector<float>& visibility, const glm::vec3& toward_key);
     std::size_t mesh_count() const;
 
     // Draws every mesh. `wrinkle_map` null, or options.wrinkles false: flat

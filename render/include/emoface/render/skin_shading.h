@@ -118,11 +118,16 @@ struct SkinShading {
     float full_sheen_gloss = 0.8f;
 
     // --- baked ambient occlusion (ambient_occlusion.h): how far it dims ---
-    float occlusion_key = 0.4f;        // the key's light where it grazes (its shadows are not drawn)
+    float occlusion_key = 0.4f;        // the key's light where it grazes (a key off its baked shadows' direction)
     float occlusion_fill = 0.8f;       // the fill's, the rim's and the sky's diffuse light
     float occlusion_specular = 1.0f;   // the sky's, the fill's and the rim's sheen
     float occlusion_key_lean = 0.5f;   // how far an occluded point's open cone leans down (occluders above)
     float occlusion_key_cone_max = 0.5f;  // the narrowest open cone's cos (the rest shape's occlusion is stale where the face moves)
+    // The key's baked cast shadows (Renderer::set_key_shadow): how deep
+    // (1: no key light in them), and the angles off the direction they were
+    // baked for at which they start and finish fading out.
+    float key_shadow = 0.85f;
+    std::array<float, 2> key_shadow_fade_deg{5.0f, 20.0f};
 
     // --- pores ---
     PoreMapSpec pores{};
