@@ -147,8 +147,16 @@ std::array<double, 3> eye_colour(const FaceShape& shape, double polar, double az
     // a bright band between lid and iris: a googly, pasted-in eye.
     const double upper_margin = shape.eye.upper(cx + x) - cy;
     const double lower_margin = shape.eye.lower(cx + x) - cy;
-    const double from_upper = glm::smoothstep(upper_margin - 3.5, upper_margin + 0.3, y);
-    const double shade = p.lid_shadow * from_upper * (0.6 + 0.4 * from_upper) +
+    // Two parts: the contact shade right under the margin (the lid's edge
+    // and the lashes' roots) and a broad soft penumbra over the iris' top
+    // and the white beside it (the lid and lashes stand off the eye, the
+    // key is a soft box above). The contact part alone, 3.5 mm wide and
+    // mostly within a millimetre, left the white bright up to the lid at
+    // 512 px: the eye read as stuck on, not sunk under the lid (blind
+    // review, session 10).
+    const double contact = glm::smoothstep(upper_margin - 1.2, upper_margin + 0.3, y);
+    const double penumbra = glm::smoothstep(upper_margin - 4.5, upper_margin + 0.3, y);
+    const double shade = p.lid_shadow * (0.6 * contact + 0.4 * penumbra) +
                          0.35 * p.lid_shadow * glm::smoothstep(lower_margin + 1.5, lower_margin - 0.5, y);
     // The corners are deeper in the socket.
     const double socket = 0.3 * glm::smoothstep(0.45 * R, 0.9 * R, std::abs(x));

@@ -170,6 +170,26 @@ FaceParams read_face_params(const std::string& params_dir) {
             p.sclera_corner_tint = r.number_in("sclera_corner_tint", 0.0, 1.0);
             p.sclera_vessels = r.number_in("sclera_vessels", 0.0, 1.0);
             p.lid_shadow = r.number_in("lid_shadow", 0.0, 0.8);
+            {
+                JsonReader l = r.object("lash_line");
+                auto& ll = p.lash_line;
+                ll.width = to_glm(l.numbers<2>("width_mm"));
+                if (!(ll.width[0] >= 0.0 && ll.width[1] >= 0.0 && ll.width[0] < 5.0 && ll.width[1] < 5.0))
+                    l.at("width_mm").fail("two widths in [0, 5) (mm)");
+                ll.amount = to_glm(l.numbers<2>("amount"));
+                if (!(ll.amount[0] >= 0.0 && ll.amount[1] >= 0.0 && ll.amount[0] <= 1.0 && ll.amount[1] <= 1.0))
+                    l.at("amount").fail("two amounts in [0, 1]");
+                ll.upper_margin = l.number_in("upper_margin", 0.0, 1.0);
+                ll.lower = l.number_in("lower", 0.0, 1.0);
+                l.finish();
+            }
+            {
+                JsonReader l = r.object("lid_crease");
+                p.lid_crease.height = l.number_in("height_mm", 1.0, 15.0);
+                p.lid_crease.width = l.number_in("width_mm", 0.2, 5.0);
+                p.lid_crease.amount = l.number_in("amount", 0.0, 0.6);
+                l.finish();
+            }
             for (auto [key, row] : {std::pair{"upper_lashes", &p.upper_lashes}, std::pair{"lower_lashes", &p.lower_lashes}}) {
                 JsonReader l = r.object(key);
                 row->count = l.integer_in("count", 0, 400);

@@ -147,6 +147,21 @@ struct FaceParams {
         double length = 0.0, width = 0.0, lift_deg = 0.0, curl_deg = 0.0;
     };
     LashRow upper_lashes, lower_lashes;
+    // the lash line painted into the lids' skin (face_texture.cpp): how far
+    // up the upper lid it reaches from the margin (mm) and how much of the
+    // lashes' colour it lays down, at the inner and the outer corner; how
+    // much of the upper margin's strip it darkens; how much the lower lid's
+    // sparse roots darken
+    struct LashLine {
+        glm::dvec2 width{0.0}, amount{0.0};
+        double upper_margin = 0.0, lower = 0.0;
+    } lash_line;
+    // the upper lid's crease painted as a soft shade line (face_texture.cpp):
+    // its height over the margin mid-lid (mm; lower towards the corners),
+    // its width (mm) and how much it darkens the skin
+    struct LidCrease {
+        double height = 0.0, width = 1.0, amount = 0.0;
+    } lid_crease;
 
     // mouth
     double mouth_y = 0.0, mouth_half_width = 0.0, mouth_corner_rise = 0.0;

@@ -110,6 +110,16 @@ private:
     // on the neck above it); *gloss becomes cloth's where it covers.
     Rgb shirt(glm::dvec3 q, Rgb c, double* gloss) const;
     void build_forelock();
+    // The painted lash line at a point of the lids: how much of the lashes'
+    // colour up the upper lid from its margin, on the upper margin's strip,
+    // and the lower lid's roots. ax: |x|; s: 0 inner .. 1 outer corner; dy_up,
+    // dy_lo: mm above the upper margin and below the lower one; along: the
+    // fade past the corners; margin: 0 on the lid's front skin .. 1 on its
+    // eyeball side.
+    struct LashLine {
+        double upper = 0.0, on_margin = 0.0, lower = 0.0;
+    };
+    LashLine lash_line(double ax, double s, double dy_up, double dy_lo, double along, double margin) const;
 
     const FaceShape& s_;
     const FaceParams& p_;
@@ -532,6 +542,65 @@ double pore_pits(const glm::dvec3& q, double spacing, double size) {
     return pit;
 }
 
+Painter::LashLine Painter::lash_line(double ax, double s, double dy_up, double dy_lo, double along, double margin) const {
+    const FaceParams::LashLine& ll = p_.lash_line;
+    LashLine out;
+    const double so = clamp01(s);
+    // No lashes over the inner few mm (the punctum's stretch), the line
+    // running on a little past the outer corner.
+    const double grown = glm::smoothstep(0.02, 0.14, s) * along;
+    const double front = 1.0 - margin;
+    if (dy_up > -1.0) {
+        // Past the outer corner the line runs on for a couple of mm,
+        // thinning and rising a little (the outermost lashes), instead of
+        // filling the corner's fade as a block.
+        const double past = std::max(0.0, (s - 1.0) * (s_.eye.x_out - s_.eye.x_in));
+        const double flick = 1.0 - glm::smoothstep(0.0, 2.5, past);
+        // Measured from the margin's front edge: seen from the front, the
+        // rounded margin (the strip, darkened below) spans about 0.55 of
+        // the lid's thickness up from the margin's curve (looked at in
+        // 2048 px renders); measured from the curve, the line ended a
+        // texel or two above the strip.
+        const double rise = dy_up - 0.55 * p_.lid_thickness * (1.0 - glm::smoothstep(0.0, 1.5, past)) - 0.35 * past;
+        const double amount = mix(ll.amount[0], ll.amount[1], so) * grown * flick;
+        // The line's top: thicker towards the outer corner, ragged where
+        // the lashes gather in clumps about 2.5 mm apart. Painted whatever
+        // the depth (margin): the strip and the skin above it are one line.
+        const double clumps = 0.5 + 0.5 * std::sin(ax * 2.3 + 1.7 * std::sin(ax * 0.9));
+        const double ragged = 0.75 + 0.35 * clumps + 0.3 * (noise(ax * 1.9, 0.0, 17.0) - 0.5);
+        const double top = mix(ll.width[0], ll.width[1], so * so) * ragged * (0.4 + 0.6 * flick);
+        const double below = past > 0.0 ? glm::smoothstep(-0.5 * top, 0.0, rise) : 1.0;
+        double cover = (1.0 - glm::smoothstep(0.4 * top, top, rise)) * below;
+        // Single roots standing above it, about 0.45 mm apart and of
+        // uneven height, so its edge is hair, not a drawn line.
+        const double cell = ax / 0.45;
+        const int k = static_cast<int>(std::floor(cell));
+        const double f = cell - k - 0.5 - 0.4 * (hash(k, 7, 211) - 0.5);
+        const double reach = top + 0.2 + 0.6 * hash(k, 7, 213);
+        const double root = std::exp(-(f / 0.2) * (f / 0.2)) * (1.0 - glm::smoothstep(0.6 * reach, reach, rise)) * below;
+        cover = std::max(cover, 0.7 * root);
+        out.upper = amount * cover;
+        // On the strip's upper half (nearer the upper margin than the
+        // lower); lighter over the inner third, where the lashes are fewer
+        // and short.
+        const double upper_half = glm::smoothstep(-0.3, 0.3, std::abs(dy_lo) - std::abs(dy_up));
+        out.on_margin = ll.upper_margin * mix(0.6, 1.0, so) * grown * upper_half;
+    }
+    if (dy_lo > -1.0) {
+        // Lower lashes: sparse and fine, about one root in two of a 0.9 mm
+        // comb, just under the margin's front edge.
+        const double cell = ax / 0.9;
+        const int k = static_cast<int>(std::floor(cell));
+        const double f = cell - k - 0.5 - 0.5 * (hash(k, 9, 221) - 0.5);
+        const double present = hash(k, 9, 223) < 0.55 ? 0.5 + 0.5 * hash(k, 9, 227) : 0.0;
+        const double root =
+            present * std::exp(-(f / 0.22) * (f / 0.22)) * (1.0 - glm::smoothstep(0.1, 0.5, std::abs(dy_lo - 0.1)));
+        const double line = 0.35 * (1.0 - glm::smoothstep(0.05, 0.3, std::abs(dy_lo)));
+        out.lower = ll.lower * grown * front * std::max(root, line);
+    }
+    return out;
+}
+
 Texel Painter::skin(glm::dvec3 q) const {
     // Colour where the symmetric face's curves put it: the shape's
     // asymmetry carries the colour with it.
@@ -778,7 +847,6 @@ Texel Painter::skin(glm::dvec3 q) const {
         // strip and the tear meniscus where the lid meets the eyeball.
         const EyeOpening& e = s_.eye;
         if (ax > e.x_in - 8 && ax < e.x_out + 10 && q.y > -18 && q.y < 22) {
-            const double s = clamp01(e.s(ax));
             const bool within = ax >= e.x_in && ax <= e.x_out;
             const double up = within ? e.upper(ax) : (ax < e.x_in ? e.y_in : e.y_out);
             const double lo = within ? e.lower(ax) : (ax < e.x_in ? e.y_in : e.y_out);
@@ -798,20 +866,36 @@ Texel Painter::skin(glm::dvec3 q) const {
             // 9 and 6 mm, with the lash line, the socket's occlusion and
             // the albedo's lid tones on top, they drew a dark smudgy ring
             // round each eye (blind review, session 9).
+            // The lash line (face.json eyes.lash_line): at 512 px a lash is
+            // a fifth of a pixel and the strands draw as dots, so the line
+            // that reads in a photograph, the lashes dense at their roots
+            // and their shadow, is painted. It covers the margin's front
+            // edge and reaches up the lid, further and darker towards the
+            // outer corner, its top edge ragged with the clumps; a fine
+            // even line of 0.35-0.75 mm at half strength drew no lash line
+            // at all, only the pink strip below it ("no lashes seen", "lid
+            // edges thick and pink": blind review, session 10).
+            const LashLine line = lash_line(ax, e.s(ax), dy_up, dy_lo, along, margin);
             if (dy_up > -1.0) {
                 const double lid = (1.0 - glm::smoothstep(0.0, 5.0, dy_up)) * along;
                 c = tint(c, {0.96, 0.9, 0.9}, 0.35 * lid);
-                // The lash roots: a fine dark line along the margin's front
-                // edge, thicker towards the outer corner, broken where the
-                // lashes grow in clumps (a solid line read as eyeliner).
-                const double reach = 0.35 + 0.4 * s;
-                const double clumps = 0.75 + 0.25 * std::sin(ax * 2.3 + 1.7 * std::sin(ax * 0.9));
-                const double lash = (1.0 - glm::smoothstep(0.05, reach, std::abs(dy_up))) * along * (1.0 - margin);
-                c = blend(c, from255(p_.lashes), 0.5 * clumps * lash);
+                c = blend(c, from255(p_.lashes), line.upper);
+                // The crease, where the lid's skin folds in under the
+                // orbital skin above it: a soft shade line, highest mid-lid
+                // and nearer the margin at the corners, fading past them.
+                // The socket's broad shade alone left the lid one smooth
+                // band between lash line and brow, a mask's shell.
+                const FaceParams::LidCrease& lc = p_.lid_crease;
+                const double crease_at = lc.height * (0.45 + 0.55 * std::sqrt(std::sin(kPi * clamp01(e.s(ax)))));
+                const double crease = std::exp(-std::pow((dy_up - crease_at) / lc.width, 2)) *
+                                      (1.0 - glm::smoothstep(0.0, 4.0, ax < e.x_in ? e.x_in - ax : ax - e.x_out));
+                const double a = lc.amount * crease;  // a little warmer than grey: skin in its own shade
+                c = c * Rgb{1.0 - a, 1.0 - 1.15 * a, 1.0 - 1.2 * a};
             }
             if (dy_lo > -1.0) {
-                const double lash = (1.0 - glm::smoothstep(0.05, 0.35, std::abs(dy_lo))) * along * (1.0 - margin);
-                c = blend(c, Rgb{0.36, 0.24, 0.21}, 0.22 * lash);
+                // Sparse fine lower lashes: broken roots under the margin's
+                // front edge, not a line.
+                c = blend(c, Rgb{0.36, 0.24, 0.21}, line.lower);
                 const double pretarsal = (1.0 - glm::smoothstep(0.5, 3.5, dy_lo)) * along * (1.0 - margin);
                 c = tint(c, {1.03, 0.97, 0.97}, 0.5 * pretarsal);
             }
@@ -819,6 +903,9 @@ Texel Painter::skin(glm::dvec3 q) const {
             const double strip = margin * near_slit * (within ? 1.0 : along);
             if (strip > 0.0) {
                 c = blend(c, from255(al.lid_margin), 0.85 * strip);
+                // The upper margin is seen from below the lashes' roots, in
+                // their shade: dark, not the lower margin's moist pink.
+                c = blend(c, from255(p_.lashes), line.on_margin * strip);
                 gloss = mix(gloss, p_.gloss.lid_margin, strip);
                 // The margin's posterior edge, where it rests on the eyeball:
                 // wet conjunctiva in the lid's own shade, a dark line that
@@ -827,11 +914,19 @@ Texel Painter::skin(glm::dvec3 q) const {
                 // band, the eye "pasted in" (blind review, issue 11).
                 const double contact = strip * (1.0 - glm::smoothstep(p_.lid_clearance + 0.15 * p_.lid_thickness,
                                                                       p_.lid_clearance + 0.5 * p_.lid_thickness, shell));
-                c = blend(c, from255(al.lid_margin) * Rgb{0.62, 0.5, 0.5}, 0.6 * contact);
+                // On the lower lid the tear meniscus lies along that edge
+                // instead (below): a dark line there as well outlined the
+                // eye all round.
+                const double lower_lid = 1.0 - glm::smoothstep(-0.3, 0.3, std::abs(dy_lo) - std::abs(dy_up));
+                c = blend(c, from255(al.lid_margin) * Rgb{0.62, 0.5, 0.5}, 0.6 * contact * (1.0 - 0.6 * lower_lid));
                 gloss = mix(gloss, p_.gloss.tear_line, contact);
-                // The tear meniscus: along the lower margin where it meets the eyeball.
+                // The tear meniscus: along the lower margin where it meets
+                // the eyeball, a thin pale wet line (the tear film over the
+                // margin's back edge catches the room), its highlight the
+                // gloss's.
                 const double tear = (1.0 - glm::smoothstep(p_.lid_clearance + 0.1, p_.lid_clearance + 0.6, shell)) *
                                     (dy_lo > -1.5 && q.y < e.slit(ax) ? 1.0 : 0.0) * along;
+                c = blend(c, Rgb{0.94, 0.84, 0.8}, 0.4 * tear);
                 gloss = mix(gloss, p_.gloss.tear_line, tear);
                 // The caruncle in the inner corner, on the deep part only: a
                 // moist pink mound about 3 mm across. At 0.6 of a duller pink

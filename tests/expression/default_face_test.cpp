@@ -615,7 +615,9 @@ TEST_F(BadFaceParams, MessagesNameTheFileAndKey) {
          "expression: " + file + ": eyes.radiuss: expected a known key (centre, radius, iris_radius, pupil_radius, "
                                 "cornea, inner_corner, outer_corner, upper_lid_height, lower_lid_height, upper_lid_peak, "
                                 "lower_lid_peak, lid_clearance, lid_thickness, lid_blend_inner, lid_blend_outer, "
-                                "lid_warp_reach, sclera_corner_tint, sclera_vessels, lid_shadow, upper_lashes, lower_lashes), found \"radiuss\""},
+                                "lid_warp_reach, sclera_corner_tint, sclera_vessels, lid_shadow, lash_line, lid_crease, upper_lashes, lower_lashes), found \"radiuss\""},
+        {replaced("\"amount\": [0.7, 0.95]", "\"amount\": [0.7, 1.5]"),
+         "expression: " + file + ": eyes.lash_line.amount: expected two amounts in [0, 1], found [0.7,1.5]"},
         {replaced("\"iris_radius\": 5.9,", ""), "expression: " + file + ": eyes.iris_radius: expected a value, found no such key"},
         {replaced("\"cornea\": {\"radius\": 7.8,", "\"cornea\": {\"radius\": 13,"),
          "expression: " + file + ": eyes.cornea.radius: expected a number in [5, 12], found 13"},

@@ -81,12 +81,14 @@ Texel texel_of(int vertex) {
     return texel_at(t[0], t[1]);
 }
 
-// The front-facing skin vertex nearest (x, y) in frontal projection.
+// The front-facing skin vertex nearest (x, y) in frontal projection. The
+// lashes are skin too, but take their colour from the atlas' tiles (v below
+// 0.25, face_texture.h kSkinV0), not the skin's painting.
 int front_vertex(double x, double y, const Face& f = painted_face()) {
     int best = -1;
     double best_d = 1e18;
     for (int v = 0; v < f.vertex_count(); ++v) {
-        if (f.parts[v] != VertexPart::Skin) continue;
+        if (f.parts[v] != VertexPart::Skin || f.mesh.texcoord2D(TriMesh::VertexHandle(v))[1] < 0.25) continue;
         const auto p = f.mesh.point(TriMesh::VertexHandle(v));
         const auto n = f.mesh.normal(TriMesh::VertexHandle(v));
         if (n[2] < 0.3) continue;
@@ -101,6 +103,36 @@ int front_vertex(double x, double y, const Face& f = painted_face()) {
 
 // Luminance along the straight UV path between the vertices nearest two
 // frontal points, `steps` + 1 samples.
+// The texel a frontal camera sees at (x, y): through the nearest (largest
+// z) skin triangle over that point, its UVs interpolated (the lids' rounded
+// margins lie between vertices, and the nearest vertex skips them).
+Texel seen_at(double x, double y, const Face& f = painted_face()) {
+    double best_z = -1e18;
+    OpenMesh::Vec2f uv(0.0f, 0.0f);
+    for (const auto fh : f.mesh.faces()) {
+        std::array<TriMesh::VertexHandle, 3> v;
+        int n = 0;
+        for (const auto vh : f.mesh.fv_range(fh)) v[n++] = vh;
+        bool skin = true;
+        for (const auto vh : v)
+            skin = skin && f.parts[vh.idx()] == VertexPart::Skin && f.mesh.texcoord2D(vh)[1] >= 0.25;
+        if (!skin) continue;
+        const auto a = f.mesh.point(v[0]), b = f.mesh.point(v[1]), c = f.mesh.point(v[2]);
+        const double d = (b[1] - c[1]) * (a[0] - c[0]) + (c[0] - b[0]) * (a[1] - c[1]);
+        if (std::abs(d) < 1e-12) continue;
+        const double w0 = ((b[1] - c[1]) * (x - c[0]) + (c[0] - b[0]) * (y - c[1])) / d;
+        const double w1 = ((c[1] - a[1]) * (x - c[0]) + (a[0] - c[0]) * (y - c[1])) / d;
+        const double w2 = 1.0 - w0 - w1;
+        if (w0 < 0 || w1 < 0 || w2 < 0) continue;
+        const double z = w0 * a[2] + w1 * b[2] + w2 * c[2];
+        if (z <= best_z) continue;
+        best_z = z;
+        uv = f.mesh.texcoord2D(v[0]) * static_cast<float>(w0) + f.mesh.texcoord2D(v[1]) * static_cast<float>(w1) +
+             f.mesh.texcoord2D(v[2]) * static_cast<float>(w2);
+    }
+    return texel_at(uv[0], uv[1], f);
+}
+
 std::vector<double> luminance_between(double x, double y0, double y1, int steps, const Face& f = painted_face()) {
     const auto a = f.mesh.texcoord2D(TriMesh::VertexHandle(front_vertex(x, y0, f)));
     const auto b = f.mesh.texcoord2D(TriMesh::VertexHandle(front_vertex(x, y1, f)));
@@ -474,6 +506,71 @@ TEST(FaceTexture, PoresAreDarkPitsMostOnTheNoseAndNoneOnTheLids) {
     EXPECT_GT(cheek, 0.01) << "and on the cheeks";
     EXPECT_GT(nose, 1.5 * cheek);
     EXPECT_LT(upper_lid, 0.25 * nose) << "the lids' pores are finer than a texel";
+}
+
+// The lids' margins (face.json eyes.lash_line): at 512 px the lash strands
+// draw as dots, so the upper lash line is painted. Up the upper lid from its
+// margin the skin is dark at the margin (the lashes' roots) and lighter
+// above; the dark line is heavier (darker times wider) towards the outer
+// corner than mid-lid; the lower margin is a pale pink, wet line, much
+// lighter than the lash line (a dark or deep red rim round the whole eye
+// read as eyeliner, a pink one as a painted rim).
+TEST(FaceTexture, UpperLashLineIsDarkAndHeavierOutwardsAndTheLowerMarginPale) {
+    const Face& f = painted_face();
+    ASSERT_FALSE(f.eyeballs.empty());
+    const Eyeball& eye = f.eyeballs[0];
+    // A frontal point s of the way along a margin (0 inner, 1 outer corner).
+    auto along = [&](const std::vector<int>& margin, double s) {
+        const double k = s * static_cast<double>(margin.size() - 1);
+        const std::size_t i = std::min(static_cast<std::size_t>(k), margin.size() - 2);
+        const auto a = f.mesh.point(TriMesh::VertexHandle(margin[i])), b = f.mesh.point(TriMesh::VertexHandle(margin[i + 1]));
+        const double t = k - static_cast<double>(i);
+        return std::pair{a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t};
+    };
+    struct Line {
+        double darkest, top, lid;
+    };
+    // Luminance as a frontal camera sees it, 0.1 mm a step from the margin
+    // 4 mm up the lid: the lid's skin is the brightest of 2.8-3.6 mm up
+    // (above the line, under the crease); the line's top is where the
+    // luminance first passes halfway from the line's darkest to the lid's.
+    auto upper_line = [&](double s) {
+        const auto [x, y] = along(eye.upper_margin, s);
+        std::vector<double> l;
+        for (int k = 0; k <= 40; ++k) l.push_back(seen_at(x, y + 0.1 * k).luminance());
+        Line line{1.0, 0.0, 0.0};
+        for (int k = 28; k <= 36; ++k) line.lid = std::max(line.lid, l[k]);
+        for (int k = 0; k <= 20; ++k) line.darkest = std::min(line.darkest, l[k]);
+        for (int k = 0; k <= 28 && l[k] < 0.5 * (line.darkest + line.lid); ++k) line.top = 0.1 * (k + 1);
+        return line;
+    };
+    // Each the mean over a few mm of lid: the line's top is ragged.
+    auto mean_line = [&](double s0, double s1) {
+        Line mean{0.0, 0.0, 0.0};
+        constexpr int kN = 6;
+        for (int k = 0; k < kN; ++k) {
+            const Line one = upper_line(s0 + (s1 - s0) * k / (kN - 1));
+            mean.darkest += one.darkest / kN;
+            mean.top += one.top / kN;
+            mean.lid += one.lid / kN;
+        }
+        return mean;
+    };
+    const Line mid = mean_line(0.35, 0.55), outer = mean_line(0.75, 0.9);
+    std::printf("upper lash line: mid darkest %.3f top %.2f mm lid %.3f; outer darkest %.3f top %.2f mm lid %.3f\n",
+                mid.darkest, mid.top, mid.lid, outer.darkest, outer.top, outer.lid);
+    for (const Line& line : {mid, outer}) EXPECT_LT(line.darkest, 0.5 * line.lid) << "the lash line is dark against the lid";
+    EXPECT_GT(outer.top, mid.top + 0.25) << "the line thickens towards the outer corner";
+    const auto [lx, ly] = along(eye.lower_margin, 0.5);
+    Texel lower{0.0, 0.0, 0.0, 1.0};
+    for (int k = 0; k <= 10; ++k) {
+        const Texel t = seen_at(lx, ly - 0.1 * k);
+        if (t.luminance() > lower.luminance()) lower = t;
+    }
+    std::printf("lower margin: rgb %.3f %.3f %.3f alpha %.3f\n", lower.r, lower.g, lower.b, lower.a);
+    EXPECT_GT(lower.luminance(), mid.darkest + 0.25) << "the lower margin is pale, not a dark rim";
+    EXPECT_GT(lower.r, 1.15 * lower.g) << "and pink";
+    EXPECT_LT(lower.a, 0.8) << "and wet (its roughness scale)";
 }
 
 }  // namespace
