@@ -123,6 +123,40 @@ bool margin_y(const std::vector<std::array<double, 2>>& m, double x, double* y) 
 }
 
 
+// The jaw under FAPs 3 (open), 14 (thrust) and 15 (shift): a turn about the
+// pivot that drops the chin (`chin`, from the pivot) by open x MNS, and a
+// translation. The condyles glide forward as the jaw opens (the mandible
+// turns and slides, so the chin goes down more than back). Turned about the
+// pivot alone (which sits high over the chin here) the chin swung back 1.4
+// times as far as it dropped and the jaw's angle as far, against skin the
+// jaw carries only part of the way (build_jaw's fades): it was pushed
+// together to under half its length over the jaw's side, the lump along the
+// jaw line and the "balloon" of surprise's lower face at 512 px. The glide
+// cancels kJawGlide of the chin's backward swing (RigSmoothness measures
+// the stretch).
+constexpr double kJawGlide = 0.6;
+
+struct JawMotion {
+    glm::dmat3 r{1.0};
+    V t{0.0};
+};
+
+JawMotion jaw_motion(const V& chin, double open, double thrust, double shift, const fap::Fapu& fapu) {
+    JawMotion m;
+    const double drop = open * fapu.mns;
+    const double a = std::hypot(chin[1], chin[2]);
+    const double phi0 = std::atan2(chin[2], chin[1]);
+    const double angle = a > 0 ? std::acos(std::clamp((chin[1] - drop) / a, -1.0, 1.0)) - phi0 : 0.0;
+    m.r = rot_x(angle);
+    const auto& i14 = fap::fap_info(14);
+    const auto& i15 = fap::fap_info(15);
+    const double back = (m.r * chin)[2] - chin[2];
+    for (int c = 0; c < 3; ++c)
+        m.t[c] = thrust * fapu.of(i14.unit) * i14.direction[c] + shift * fapu.of(i15.unit) * i15.direction[c];
+    m.t[2] -= kJawGlide * back;
+    return m;
+}
+
 }  // namespace
 
 // Both contours move: the corners, where they lie 2 mm apart, would tear
@@ -649,7 +683,10 @@ void FaceRig::build_jaw(const Face& face) {
     const double y_mid = 0.5 * (p22[1] + p23[1]), y_corner = 0.5 * (pl[1] + pr[1]);
     const double z_corner = 0.5 * (pl[2] + pr[2]);
     const V P = jaw_pivot_;
-    const double delta = 0.25 * es0;
+    // Half the height of the fade across the line from the mouth corners
+    // to the jaw joint (at 0.25 the cheek's skin over the line was pushed
+    // together more as the jaw dropped).
+    const double delta = 0.35 * es0;
 
     // Which side of the mouth a vertex is on, by distance along the skin:
     // across the closed lips the two sides are far apart.
@@ -680,14 +717,19 @@ void FaceRig::build_jaw(const Face& face) {
             // Fully on the jaw (lower lip) or off it (upper) only mid-mouth:
             // towards the corners both lips follow it partly, so an open
             // mouth is an oval narrowing into closed corners, not a slot.
+            // The lip's share joins the line's by products, not max/min: a
+            // max or min kinks the weight where the two cross (square
+            // contours beside the mouth, a fold from each corner down to
+            // the chin and a bulge beside it when the jaw drops).
             const double lip = 1.0 - glm::smoothstep(0.15 * half_width, 1.15 * half_width, std::abs(x - mx));
-            w = to_lower[v] < to_upper[v] ? std::max(w, lip) : std::min(w, 1.0 - lip);
+            w = to_lower[v] < to_upper[v] ? 1.0 - (1.0 - w) * (1.0 - lip) : w * (1.0 - lip);
         }
         // The neck below the chin and the head behind the jaw joint stay; the
         // fades are long so a wide-open jaw stretches the skin instead of
-        // folding it.
+        // folding it (the one from back to front runs over the jaw's whole
+        // side: 0.6 ES0 long, it pushed that skin together).
         w *= glm::smoothstep(chin_y - 0.8 * es0, chin_y - 0.08 * es0, y);
-        w *= glm::smoothstep(P[2] - 0.1 * es0, P[2] + 0.6 * es0, z);
+        w *= glm::smoothstep(P[2] - 0.1 * es0, P[2] + 1.0 * es0, z);
         jaw_weight_[v] = static_cast<float>(w);
     }
     for (int v = 0; v < n; ++v)
@@ -931,16 +973,10 @@ RigFrame FaceRig::frame(const FapValues& given) const {
     // thrust (14) and shift (15).
     const double open = faps[2], thrust = faps[13], shift = faps[14];
     if (has_jaw_ && (open != 0 || thrust != 0 || shift != 0)) {
-        const V chin = to_v(fps_[fap::feature_point_index("2.1")].position) - jaw_pivot_;
-        const double drop = open * fapu_.mns;
-        const double a = std::hypot(chin[1], chin[2]);
-        const double phi0 = std::atan2(chin[2], chin[1]);
-        const double angle = a > 0 ? std::acos(std::clamp((chin[1] - drop) / a, -1.0, 1.0)) - phi0 : 0.0;
-        copy(rot_x(angle), f.jaw_r);
-        const auto& i14 = fap::fap_info(14);
-        const auto& i15 = fap::fap_info(15);
+        const JawMotion m = jaw_motion(to_v(fps_[fap::feature_point_index("2.1")].position) - jaw_pivot_, open, thrust, shift, fapu_);
+        copy(m.r, f.jaw_r);
         for (int c = 0; c < 3; ++c) {
-            f.jaw_t[c] = thrust * fapu_.of(i14.unit) * i14.direction[c] + shift * fapu_.of(i15.unit) * i15.direction[c];
+            f.jaw_t[c] = m.t[c];
             f.jaw_pivot[c] = jaw_pivot_[c];
         }
         f.jaw = true;
@@ -1122,17 +1158,9 @@ DeformedFace FaceRig::deform_reference(const FapValues& given) const {
     // thrust (14) and shift (15).
     const double open = faps[2], thrust = faps[13], shift = faps[14];
     if (has_jaw_ && (open != 0 || thrust != 0 || shift != 0)) {
-        const V chin = to_v(fps_[fap::feature_point_index("2.1")].position) - jaw_pivot_;
-        const double drop = open * fapu_.mns;
-        const double a = std::hypot(chin[1], chin[2]);
-        const double phi0 = std::atan2(chin[2], chin[1]);
-        const double angle = a > 0 ? std::acos(std::clamp((chin[1] - drop) / a, -1.0, 1.0)) - phi0 : 0.0;
-        const glm::dmat3 r = rot_x(angle);
-        const auto& i14 = fap::fap_info(14);
-        const auto& i15 = fap::fap_info(15);
-        V t(0.0);
-        for (int c = 0; c < 3; ++c)
-            t[c] = thrust * fapu_.of(i14.unit) * i14.direction[c] + shift * fapu_.of(i15.unit) * i15.direction[c];
+        const JawMotion m = jaw_motion(to_v(fps_[fap::feature_point_index("2.1")].position) - jaw_pivot_, open, thrust, shift, fapu_);
+        const glm::dmat3& r = m.r;
+        const V& t = m.t;
         for (int v : jaw_vertices_) {
             const V p = to_v(pos[v]);
             const V moved = r * (p - jaw_pivot_) + jaw_pivot_ + t;

@@ -159,6 +159,14 @@ constexpr double kSheet = 25.0;
 // far), but no triangle turns over against its neighbour. Open work: tighten
 // it as the lips' and the jaw's fields get the sheet treatment.
 constexpr double kSinglePoint = 90.0;
+// The jaw (FAPs 3, 14, 15; AU26, AU27) stretches the skin between itself and
+// the still face as a sheet: its weight's fades are smooth products and long
+// (rig.cpp, build_jaw) and the chin drops more than it swings back
+// (kJawGlide). Measured 8 degrees at most for the jaw's FAPs (open_jaw 700)
+// and 11.3 for AU27, whose lip FAPs crowd the lower lip; the max/min weight
+// and the swing alone gave 20-26 (a fold from each mouth corner down towards
+// the chin, surprise's bulge beside the mouth).
+constexpr double kJaw = 14.0;
 
 std::vector<Case> cases() {
     std::vector<Case> out;
@@ -174,17 +182,19 @@ std::vector<Case> cases() {
             FapValues faps{};
             faps[f - 1] = v;
             const bool sheet = f == 49 || f == 50 || (f >= 19 && f <= 22);
+            const bool jaw = f == 3 || f == 14 || f == 15;
             out.push_back({"FAP " + std::to_string(f) + " " + std::string(fap::fap_info(f).name) + " at " +
                                std::to_string(static_cast<int>(v)),
-                           faps, sheet ? kSheet : kSinglePoint});
+                           faps, jaw ? kJaw : sheet ? kSheet : kSinglePoint});
         }
     }
     // Every AU at full intensity: the upper face's as sheets; the mouth's
     // crowd the lip points (as single FAPs above).
     for (const ActionUnit& au : profiles().action_units.units) {
         if (au.number >= 51) continue;  // head and gaze: rigid turns
-        const bool upper = au.number <= 9 || (au.number >= 41 && au.number <= 46) || au.number == 26;
-        out.push_back({"AU" + std::to_string(au.number), au.faps, upper ? kSheet : kSinglePoint});
+        const bool upper = au.number <= 9 || (au.number >= 41 && au.number <= 46);
+        const bool jaw = au.number == 26 || au.number == 27;
+        out.push_back({"AU" + std::to_string(au.number), au.faps, jaw ? kJaw : upper ? kSheet : kSinglePoint});
     }
     // The one-sided brow raise the observers saw tent the forehead.
     FapValues brow{};
@@ -365,6 +375,66 @@ TEST(RigSmoothness, SkinBesideAStretchedMouthCornerSlidesRatherThanRises) {
         }
         std::printf("AU20 corner %s: %.1f mm out; the skin beside it rises at most %.1f mm\n", id, out, rise);
         EXPECT_LT(rise, 0.6 * out) << id;
+    }
+}
+
+// A dropped jaw stretches the skin it carries part of the way (between the
+// jaw and the still face: beside the mouth, over the jaw's side) like a
+// sheet; it does not push it together into a lump (surprise's "balloon" at
+// 512 px, blind review session 9: the jaw turned about its pivot swung the
+// chin back 1.4 times as far as it dropped, and its side as far, against
+// skin that stayed). Measured as the smallest principal stretch of the skin
+// triangles of the lower face's sides: lateral to the mouth's middle, from
+// the nose wings down to 5 mm below the chin, in front of the jaw's angles,
+// away from the mouth slit. Before the condyles' glide and the smooth,
+// longer fades (rig.cpp, kJawGlide and build_jaw) the jaw's side was pushed
+// together to 0.46 of its length in surprise and 0.39 in AU26; now 0.84 and
+// 0.82, the least under the jaw's edge.
+TEST(RigSmoothness, ADroppedJawStretchesTheSkinItCarriesPartOfTheWay) {
+    const Face& face = test_face();
+    const SkinEdges& e = skin_edges();
+    std::vector<Vec3d> p0(face.vertex_count());
+    for (int v = 0; v < face.vertex_count(); ++v) p0[v] = to_vec(face.mesh.point(TriMesh::VertexHandle(v)));
+    const double top = face.position(fp("9.1"))[1], bottom = face.position(fp("2.1"))[1] - 5.0;
+    const double back = std::max(face.position(fp("2.13"))[2], face.position(fp("2.14"))[2]);
+    const double middle = 0.7 * std::abs(face.position(fp("2.4"))[0] - face.position(fp("2.5"))[0]) / 2;
+    std::vector<std::array<int, 3>> tris;
+    for (const auto& t : e.triangles) {
+        Vec3d c{0, 0, 0};
+        for (int v : t)
+            for (int k = 0; k < 3; ++k) c[k] += p0[v][k] / 3;
+        if (std::abs(c[0]) > middle && c[1] < top && c[1] > bottom && c[2] > back) tris.push_back(t);
+    }
+    ASSERT_GT(tris.size(), 500u);
+    // The smallest principal stretch of a triangle: sqrt of the smaller
+    // eigenvalue of its deformed metric against its neutral one.
+    auto smallest_stretch = [&](const std::vector<Vec3d>& p, const std::array<int, 3>& t) {
+        const Vec3d e1 = sub(p0[t[1]], p0[t[0]]), e2 = sub(p0[t[2]], p0[t[0]]);
+        const Vec3d f1 = sub(p[t[1]], p[t[0]]), f2 = sub(p[t[2]], p[t[0]]);
+        const double m11 = dot(e1, e1), m12 = dot(e1, e2), m22 = dot(e2, e2);
+        const double g11 = dot(f1, f1), g12 = dot(f1, f2), g22 = dot(f2, f2);
+        const double det_m = m11 * m22 - m12 * m12;
+        if (det_m <= 0) return 1.0;
+        // M^-1 G, a 2x2 with real positive eigenvalues.
+        const double a = (m22 * g11 - m12 * g12) / det_m, b = (m22 * g12 - m12 * g22) / det_m;
+        const double c = (m11 * g12 - m12 * g11) / det_m, d = (m11 * g22 - m12 * g12) / det_m;
+        const double tr = a + d, det = a * d - b * c;
+        return std::sqrt(std::max(0.5 * (tr - std::sqrt(std::max(tr * tr - 4 * det, 0.0))), 0.0));
+    };
+    const ActionUnit* au26 = profiles().action_units.find(26);
+    ASSERT_NE(au26, nullptr);
+    for (const auto& [what, faps] : {std::pair{std::string("surprise"), profiles()[Emotion::Surprise]},
+                                     std::pair{std::string("AU26"), au26->faps}}) {
+        const std::vector<Vec3d> p = positions(test_rig().deform(faps).positions);
+        double worst = 1.0;
+        Vec3d at{};
+        for (const auto& t : tris) {
+            const double s = smallest_stretch(p, t);
+            if (s < worst) worst = s, at = p0[t[0]];
+        }
+        std::printf("%s: the lower face's sides stretch at least %.2f (at %.1f, %.1f, %.1f)\n", what.c_str(), worst,
+                    at[0], at[1], at[2]);
+        EXPECT_GT(worst, 0.75) << what << " at (" << at[0] << ", " << at[1] << ", " << at[2] << ")";
     }
 }
 
