@@ -150,13 +150,17 @@ std::array<double, 3> eye_colour(const FaceShape& shape, double polar, double az
     // Two parts: the contact shade right under the margin (the lid's edge
     // and the lashes' roots) and a broad soft penumbra over the iris' top
     // and the white beside it (the lid and lashes stand off the eye, the
-    // key is a soft box above). The contact part alone, 3.5 mm wide and
-    // mostly within a millimetre, left the white bright up to the lid at
+    // key is a soft box above). One ramp over 3.5 mm, mostly within a
+    // millimetre, left the white bright up to a pixel under the lid at
     // 512 px: the eye read as stuck on, not sunk under the lid (blind
     // review, session 10).
-    const double contact = glm::smoothstep(upper_margin - 1.2, upper_margin + 0.3, y);
-    const double penumbra = glm::smoothstep(upper_margin - 4.5, upper_margin + 0.3, y);
-    const double shade = p.lid_shadow * (0.6 * contact + 0.4 * penumbra) +
+    const double contact = glm::smoothstep(upper_margin - 2.0, upper_margin + 0.3, y);
+    const double penumbra = glm::smoothstep(upper_margin - 5.0, upper_margin + 0.3, y);
+    // Above the rest margin, bared only by a raised lid (surprise, fear),
+    // it eases back to 0.8 of that: at the full shade the bared white over
+    // the iris read as a grey band.
+    const double bared = 1.0 - 0.2 * glm::smoothstep(upper_margin + 0.3, upper_margin + 1.5, y);
+    const double shade = p.lid_shadow * (0.55 * contact + 0.45 * penumbra) * bared +
                          0.35 * p.lid_shadow * glm::smoothstep(lower_margin + 1.5, lower_margin - 0.5, y);
     // The corners are deeper in the socket.
     const double socket = 0.3 * glm::smoothstep(0.45 * R, 0.9 * R, std::abs(x));
