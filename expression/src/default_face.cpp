@@ -639,7 +639,6 @@ void Generator::build_lashes(Face& face, int side, bool upper) {
         const double s = 0.05 + 0.9 * (k + 0.5 + 0.8 * (uniform() - 0.5)) / row.count;
         const int clump_first = k - k % kClump;
         const double clump_s = root_s(clump_first + 0.5 * (std::min(kClump, row.count - clump_first) - 1));
-        const double pull = kClumpPull * (clump_s - s) * arc.back();
         const double at = s * arc.back();
         std::size_t i = 1;
         while (i + 1 < arc.size() && arc[i] < at) ++i;
@@ -657,6 +656,11 @@ void Generator::build_lashes(Face& face, int side, bool upper) {
         // Longest mid-lid, shortest at the inner end (FIDELITY.md).
         const double len = row.length * (0.45 + 0.55 * std::pow(std::sin(kPi * s), 0.6)) * (0.75 + 0.25 * s) *
                            (0.75 + 0.5 * uniform());
+        // The tip's pull towards the clump's middle, at most 0.4 of the
+        // lash's length: a sparse row's gaps (the lower lashes', 1.3 mm)
+        // pulled a short lash's tip further sideways than it is long, and
+        // its ribbon folded over itself (DefaultFace.SkinIsOrientedOutward).
+        const double pull = std::clamp(kClumpPull * (clump_s - s) * arc.back(), -0.4 * len, 0.4 * len);
         // Uneven lengths and directions: a comb of like lashes reads as a brush.
         const double lift = (row.lift_deg + 18.0 * (uniform() - 0.5)) * kDeg;
         const double curl = row.curl_deg * (0.8 + 0.4 * uniform()) * kDeg;
