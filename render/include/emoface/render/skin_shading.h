@@ -100,14 +100,14 @@ struct SkinShading {
     // How far the diffuse normal leans from the bumped normal to the
     // geometric one (Penner's softened normals: red scatters farthest), for
     // red and for green and blue (one lookup of the table for both).
-    glm::vec2 normal_softening{0.5f, 0.2f};
+    glm::vec2 normal_softening{0.3f, 0.1f};
     // How much the wrinkle cavity darkens direct diffuse light (ambient light
     // is darkened fully).
     float cavity_direct = 0.9f;
 
     // --- specular: two GGX lobes with Fresnel ---
     float f0 = 0.028f;
-    std::array<float, 2> roughness{0.5f, 0.75f};
+    std::array<float, 2> roughness{0.45f, 0.7f};
     float lobe_weight = 0.85f;  // of roughness[0]; the other lobe gets the rest
     // Regions (the base map's alpha g, 1 on cheeks and the lower face):
     // roughness x g^gloss_exponent, and the lights' sheen scaled from
@@ -132,10 +132,10 @@ struct SkinShading {
     // --- pores ---
     PoreMapSpec pores{};
     float pore_tiles = 48.0f;    // pore tiles per unit of the base UVs
-    float pore_strength = 0.6f;  // scale of the pore normals' tilt
+    float pore_strength = 0.8f;  // scale of the pore normals' tilt
 
     // --- detail from the albedo ---
-    float albedo_bump_mm = 0.5f;   // height per unit of log-luminance contrast
+    float albedo_bump_mm = 0.8f;   // height per unit of log-luminance contrast
     float albedo_bump_bias = 2.0f;  // the mean's extent, in mip levels (skin_maps.h)
 
     // --- hair: where the base colour's local mean is dark (skin_maps.h) ---
