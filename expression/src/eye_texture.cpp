@@ -156,11 +156,11 @@ std::array<double, 3> eye_colour(const FaceShape& shape, double polar, double az
     // review, session 10).
     const double contact = glm::smoothstep(upper_margin - 2.0, upper_margin + 0.3, y);
     const double penumbra = glm::smoothstep(upper_margin - 5.0, upper_margin + 0.3, y);
-    // Above the rest margin, bared only by a raised lid (surprise, fear),
-    // it eases back to 0.8 of that: at the full shade the bared white over
-    // the iris read as a grey band.
-    const double bared = 1.0 - 0.2 * glm::smoothstep(upper_margin + 0.3, upper_margin + 1.5, y);
-    const double shade = p.lid_shadow * (0.55 * contact + 0.45 * penumbra) * bared +
+    // It rises to 0.8 of lid_shadow and holds there, over the white that
+    // only a raised lid bares (surprise, fear): at the full shade that
+    // white over the iris read as a grey band, and eased back above the
+    // rest margin it drew a darker stripe along that margin.
+    const double shade = p.lid_shadow * std::min(0.55 * contact + 0.45 * penumbra, 0.8) +
                          0.35 * p.lid_shadow * glm::smoothstep(lower_margin + 1.5, lower_margin - 0.5, y);
     // The corners are deeper in the socket.
     const double socket = 0.3 * glm::smoothstep(0.45 * R, 0.9 * R, std::abs(x));
