@@ -6,8 +6,10 @@
 // lids keep only a gentle shade and the lower lids under half theirs; skin
 // away from the mouth and the eyes keeps the plain bake.
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
+#include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 #include <gtest/gtest.h>
 
@@ -189,6 +191,35 @@ TEST(FaceOcclusion, LowerLidsKeepLessThanHalfTheirRestShade) {
         EXPECT_LE(kept_most, 0.5f) << side;
         EXPECT_GT(dark_sum, 0.0f) << side;  // a little shade stays
     }
+}
+
+// The key's cast shadows (bake_face_light_visibility) for the portrait key
+// (FaceScene::portrait_light: up and to the viewer's left, -x): the nose
+// shades the skin beside its far wing and not beside the near one, the jaw
+// the neck under it, and the forehead is open to the key.
+TEST(FaceOcclusion, PortraitKeysShadowFallsBesideTheNoseAndUnderTheJaw) {
+    const Baked& b = baked();
+    const glm::vec3 toward_key = glm::normalize(glm::vec3(-0.53f, 0.57f, 0.63f));
+    const std::vector<float> visible = emoface::render::bake_face_light_visibility(b.mesh, b.face, toward_key, 10.0f, 12);
+    ASSERT_EQ(visible.size(), b.mesh.n_vertices());
+    // The skin vertex nearest (x, y) among those facing the camera most (the front surface).
+    auto front = [&](float x, float y) {
+        int best = -1;
+        float best_d = 1e9f;
+        for (const auto vh : b.mesh.vertices()) {
+            if (b.face.parts[std::size_t(vh.idx())] != ex::VertexPart::Skin || b.mesh.normal(vh)[2] < 0.3f) continue;
+            const auto& p = b.mesh.point(vh);
+            const float d = std::hypot(p[0] - x, p[1] - y) - 0.01f * p[2];
+            if (d < best_d) best_d = d, best = vh.idx();
+        }
+        return visible[std::size_t(best)];
+    };
+    // Beside the nose's wing, below it: the far side in its shadow, the near side lit.
+    EXPECT_LT(front(19.0f, -46.0f), 0.7f) << "the nose shades the skin beside its far wing";
+    EXPECT_GT(front(-19.0f, -46.0f), 0.95f) << "and not beside its near one";
+    EXPECT_GT(front(0.0f, 50.0f), 0.95f) << "the forehead";
+    EXPECT_LT(front(12.0f, -118.0f), 0.5f) << "the neck under the jaw";
+    EXPECT_GT(front(-40.0f, -20.0f), 0.95f) << "the cheek on the key's side";
 }
 
 }  // namespace

@@ -38,7 +38,9 @@ std::vector<float> bake_face_occlusion(const expression::TriMesh& mesh, const ex
 // the jaw's on the neck), the light seen as a disc of `half_angle_deg`
 // around `toward_light` (mesh space) from `samples` directions. The same
 // bake as above (the lashes cast nothing, the lids keep a share, the lips
-// see past each other), but for the mouth interior, left open (1).
+// see past each other), but for the mouth interior, left open (1); then
+// smoothed over the surface a little (the height maps' texels stair-step a
+// shadow's edge).
 std::vector<float> bake_face_light_visibility(const expression::TriMesh& mesh, const expression::Face& face,
                                               const glm::vec3& toward_light, float half_angle_deg, int samples);
 
