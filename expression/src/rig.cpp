@@ -86,7 +86,14 @@ constexpr double kCornerShare = 1.2, kUpperLipShare = 1.0;
 // (which creased it past the smoothness bound).
 constexpr double kMassUp = -0.1, kMassForward = 0.45, kMassOut = 0.06;
 // Its reach from its centre, and the fold's width (inside, outside), in ES0.
-constexpr double kMassRadius = 0.45, kFoldInside = 0.02, kFoldOutside = 0.10;
+// Its bell is (1 - t^2)^3, round on top: a C2 Wendland bell over 0.45 ES0
+// bends most at its peak, and joy's apple came forward as a pointed crest
+// (14 degrees of crease at its top on the half-resolution test face, now 5)
+// with a steep outer flank that the key light drew as a dark streak from
+// below the outer eye corner to the nose wing at 512 px (blind review,
+// session 9). Over 0.6 ES0 it reached the nose wing, past the fold's top,
+// and creased the skin there (AU6 30 degrees).
+constexpr double kMassRadius = 0.55, kFoldInside = 0.02, kFoldOutside = 0.10;
 // Its centre's share of the cheekbone (5.3) against the nose wing (9.1).
 constexpr double kCentreOnCheekbone = 0.6;
 // The lower lid's share of the cheek's rise at its widest (AU6 pushing it
@@ -607,7 +614,8 @@ void FaceRig::build_cheek_masses(detail::GeodesicGraph& graph, double es) {
             if (parts_[v] != VertexPart::Skin) continue;
             const double g = glm::length(to_v(neutral_[v]) - middle);
             const double s = beside_fold({neutral_[v][0], neutral_[v][1]});
-            const double w = wendland(g / radius) * glm::smoothstep(-kFoldInside * es, kFoldOutside * es, s);
+            const double round = std::max(1.0 - (g / radius) * (g / radius), 0.0);
+            const double w = round * round * round * glm::smoothstep(-kFoldInside * es, kFoldOutside * es, s);
             if (w > 1e-5) lid_weights_.push_back({v, entry, static_cast<float>(w)});
         }
     }

@@ -111,18 +111,20 @@ TEST_P(EachFap, MovesItsFeaturePointAlongTheTableDirectionAndNothingFar) {
         EXPECT_GT(d.feature_points[fp("6.4")][1] - face.position(fp("6.4"))[1], 0.1);
     } else {
         const double along = dot(moved, info.direction);
-        EXPECT_NEAR(along, expected, 0.02 * std::abs(expected) + 1e-4);
+        // The cheek point lies in the apple of the cheek's reach, which holds
+        // its rise back by a tenth of its share there (rig.cpp, kMassUp).
+        EXPECT_NEAR(along, expected, (f == 41 || f == 42 ? 0.07 : 0.02) * std::abs(expected) + 1e-4);
         Vec3d across = moved;
         for (int c = 0; c < 3; ++c) across[c] -= along * info.direction[c];
         // Lids slide over the eyeball, which moves them in z as well; a
         // stretched mouth corner glides back round the teeth, 0.6 of its
         // outward move into the plane of the skin beside it (rig.cpp,
         // build_corner_glide), and a rising cheek comes forward over the
-        // bone a little (rig.cpp, kMassForward).
+        // bone with the apple of the cheek (rig.cpp, kMassForward).
         double allowed = 0.05;
         if (f >= 19 && f <= 22) allowed = 0.7;
         if (f == 6 || f == 7 || f == 53 || f == 54) allowed = 0.7;
-        if (f == 41 || f == 42) allowed = 0.07;
+        if (f == 41 || f == 42) allowed = 0.3;
         EXPECT_LT(norm(across), allowed * std::abs(expected) + 1e-4);
     }
 
@@ -134,7 +136,7 @@ TEST_P(EachFap, MovesItsFeaturePointAlongTheTableDirectionAndNothingFar) {
     double reach = 2.0 * std::max(test_rig().influence_radius(k), 0.35 * es0) + 0.5;
     // A mouth corner's rise bunches the apple of the cheek (rig.cpp, kMassRadius).
     if (f == 12 || f == 13 || f == 59 || f == 60)
-        reach = std::max(reach, distance(origin, face.position(fp(f % 2 == 0 ? "5.3" : "5.4"))) + 0.45 * es0 + 0.5);
+        reach = std::max(reach, distance(origin, face.position(fp(f % 2 == 0 ? "5.3" : "5.4"))) + 0.55 * es0 + 0.5);
     bool skip_far = false;
     if (f == 3 || f == 14 || f == 15) {
         skip_far = true;  // checked below: the head above the mouth stays
