@@ -114,12 +114,12 @@ private:
     // colour up the upper lid from its margin, on the upper margin's strip,
     // and the lower lid's roots. ax: |x|; s: 0 inner .. 1 outer corner; dy_up,
     // dy_lo: mm above the upper margin and below the lower one; along: the
-    // fade past the corners; margin: 0 on the lid's front skin .. 1 on its
-    // eyeball side.
+    // fade past the corners. Painted whatever the depth: from the front the
+    // margins' rounded edges, not the lids' front skin, meet the slit.
     struct LashLine {
         double upper = 0.0, on_margin = 0.0, lower = 0.0;
     };
-    LashLine lash_line(double ax, double s, double dy_up, double dy_lo, double along, double margin) const;
+    LashLine lash_line(double ax, double s, double dy_up, double dy_lo, double along) const;
 
     const FaceShape& s_;
     const FaceParams& p_;
@@ -542,14 +542,13 @@ double pore_pits(const glm::dvec3& q, double spacing, double size) {
     return pit;
 }
 
-Painter::LashLine Painter::lash_line(double ax, double s, double dy_up, double dy_lo, double along, double margin) const {
+Painter::LashLine Painter::lash_line(double ax, double s, double dy_up, double dy_lo, double along) const {
     const FaceParams::LashLine& ll = p_.lash_line;
     LashLine out;
     const double so = clamp01(s);
     // No lashes over the inner few mm (the punctum's stretch), the line
     // running on a little past the outer corner.
     const double grown = glm::smoothstep(0.02, 0.14, s) * along;
-    const double front = 1.0 - margin;
     if (dy_up > -1.0) {
         // Past the outer corner the line runs on for a couple of mm,
         // thinning and rising a little (the outermost lashes), instead of
@@ -564,8 +563,7 @@ Painter::LashLine Painter::lash_line(double ax, double s, double dy_up, double d
         const double rise = dy_up - 0.55 * p_.lid_thickness * (1.0 - glm::smoothstep(0.0, 1.5, past)) - 0.35 * past;
         const double amount = mix(ll.amount[0], ll.amount[1], so) * grown * flick;
         // The line's top: thicker towards the outer corner, ragged where
-        // the lashes gather in clumps about 2.5 mm apart. Painted whatever
-        // the depth (margin): the strip and the skin above it are one line.
+        // the lashes gather in clumps about 2.5 mm apart.
         const double clumps = 0.5 + 0.5 * std::sin(ax * 2.3 + 1.7 * std::sin(ax * 0.9));
         const double ragged = 0.75 + 0.35 * clumps + 0.3 * (noise(ax * 1.9, 0.0, 17.0) - 0.5);
         const double top = mix(ll.width[0], ll.width[1], so * so) * ragged * (0.4 + 0.6 * flick);
@@ -586,17 +584,21 @@ Painter::LashLine Painter::lash_line(double ax, double s, double dy_up, double d
         const double upper_half = glm::smoothstep(-0.3, 0.3, std::abs(dy_lo) - std::abs(dy_up));
         out.on_margin = ll.upper_margin * mix(0.6, 1.0, so) * grown * upper_half;
     }
-    if (dy_lo > -1.0) {
+    if (dy_lo > -1.0 && s < 1.0) {
         // Lower lashes: sparse and fine, about one root in two of a 0.9 mm
-        // comb, just under the margin's front edge.
+        // comb, just under the margin's front edge, which the front sees
+        // about 0.45 mm under the margin's curve (the strip's pale line
+        // above it; looked at in 2048 px renders). Within the opening only:
+        // past the outer corner they drew a row of dots beside the canthus.
+        const double edge = dy_lo - 0.45;
         const double cell = ax / 0.9;
         const int k = static_cast<int>(std::floor(cell));
         const double f = cell - k - 0.5 - 0.5 * (hash(k, 9, 221) - 0.5);
         const double present = hash(k, 9, 223) < 0.55 ? 0.5 + 0.5 * hash(k, 9, 227) : 0.0;
         const double root =
-            present * std::exp(-(f / 0.22) * (f / 0.22)) * (1.0 - glm::smoothstep(0.1, 0.5, std::abs(dy_lo - 0.1)));
-        const double line = 0.35 * (1.0 - glm::smoothstep(0.05, 0.3, std::abs(dy_lo)));
-        out.lower = ll.lower * grown * front * std::max(root, line);
+            present * std::exp(-(f / 0.22) * (f / 0.22)) * (1.0 - glm::smoothstep(0.15, 0.5, std::abs(edge - 0.15)));
+        const double line = 0.35 * (1.0 - glm::smoothstep(0.05, 0.3, std::abs(edge)));
+        out.lower = ll.lower * grown * (1.0 - glm::smoothstep(0.92, 1.0, s)) * std::max(root, line);
     }
     return out;
 }
@@ -875,7 +877,7 @@ Texel Painter::skin(glm::dvec3 q) const {
             // even line of 0.35-0.75 mm at half strength drew no lash line
             // at all, only the pink strip below it ("no lashes seen", "lid
             // edges thick and pink": blind review, session 10).
-            const LashLine line = lash_line(ax, e.s(ax), dy_up, dy_lo, along, margin);
+            const LashLine line = lash_line(ax, e.s(ax), dy_up, dy_lo, along);
             if (dy_up > -1.0) {
                 const double lid = (1.0 - glm::smoothstep(0.0, 5.0, dy_up)) * along;
                 c = tint(c, {0.96, 0.9, 0.9}, 0.35 * lid);
