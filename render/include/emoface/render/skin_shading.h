@@ -126,7 +126,7 @@ struct SkinShading {
     // The key's baked cast shadows (Renderer::set_key_shadow): how deep
     // (1: no key light in them), and the angles off the direction they were
     // baked for at which they start and finish fading out.
-    float key_shadow = 0.85f;
+    float key_shadow = 1.0f;
     std::array<float, 2> key_shadow_fade_deg{5.0f, 20.0f};
 
     // --- pores ---
@@ -157,11 +157,11 @@ struct SkinShading {
     // --- light rig (the key light is the draw's Light, tinted) ---
     glm::vec3 key_tint{1.06f, 0.98f, 0.88f};
     float softness = 0.1f;  // wrap of every rig light's N.L (soft boxes), energy kept
-    RigLight fill{{0.5f, 0.1f, 0.86f}, {0.16f, 0.18f, 0.22f}};
+    RigLight fill{{0.5f, 0.1f, 0.86f}, {0.11f, 0.125f, 0.155f}};
     RigLight rim{{0.5f, 0.6f, -0.65f}, {0.2f, 0.19f, 0.17f}};
-    glm::vec3 sky{0.14f, 0.155f, 0.18f};      // ambient from above (+y)
+    glm::vec3 sky{0.1f, 0.11f, 0.13f};      // ambient from above (+y)
     glm::vec3 ground{0.08f, 0.06f, 0.05f};  // ambient from below (warm bounce)
-    float exposure = 0.85f;
+    float exposure = 0.9f;
     ToneMapping tone_mapping = ToneMapping::Aces;
 
     bool operator==(const SkinShading& o) const {
