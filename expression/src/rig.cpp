@@ -51,16 +51,22 @@ bool is_point_fap(int f) {
 // distance to the neighbours on the same feature, and wider where skin moves
 // in broad sheets: a brow's reaches the hairline (the forehead rises as one
 // sheet), a cheek's the cheekbone and the jaw. The anchors' hold fades as
-// gently as the moving points' pull, or the skin creases against them.
+// gently as the moving points' pull, or the skin creases against them. The
+// mouth corners' (2.4, 2.5, 8.3, 8.4) reach the cheek and the jaw's side: at
+// 0.32 a corner drawn down or out pushed the skin ahead of it together into
+// a crescent (to 0.43 of its length below the corner in AU15, now 0.61),
+// the bulges beside the mouth corners in sadness and fear and the lump and
+// fold on fear's jaw, and creased AU12 by 54 degrees and AU20 by 50 (now 14
+// and 24, rig_smoothness_test).
 double radius_factor(std::string_view id) {
     static const std::map<std::string_view, double> table = {
-        {"2.2", 0.26},  {"2.3", 0.26},  {"2.4", 0.32},  {"2.5", 0.32},  {"2.6", 0.26},  {"2.7", 0.26},
+        {"2.2", 0.26},  {"2.3", 0.26},  {"2.4", 0.45},  {"2.5", 0.45},  {"2.6", 0.26},  {"2.7", 0.26},
         {"2.8", 0.26},  {"2.9", 0.26},  {"2.10", 0.5},  {"2.11", 0.3},  {"2.12", 0.3},  {"2.13", 0.35},
         {"2.14", 0.35}, {"3.1", 0.22},  {"3.2", 0.22},  {"3.3", 0.18},  {"3.4", 0.18},  {"3.7", 0.15},
         {"3.8", 0.15},  {"3.11", 0.15}, {"3.12", 0.15}, {"4.1", 1.0},   {"4.2", 1.0},   {"4.3", 1.05},
         {"4.4", 1.05},  {"4.5", 1.0},   {"4.6", 1.0},  {"5.1", 0.7},   {"5.2", 0.7},   {"5.3", 0.65},
         {"5.4", 0.65},  {"6.1", 0.3},   {"6.2", 0.3},   {"6.3", 0.25},  {"6.4", 0.25},  {"8.1", 0.28},
-        {"8.2", 0.28},  {"8.3", 0.32},  {"8.4", 0.32},  {"8.5", 0.26},  {"8.6", 0.26},  {"8.7", 0.26},
+        {"8.2", 0.28},  {"8.3", 0.45},  {"8.4", 0.45},  {"8.5", 0.26},  {"8.6", 0.26},  {"8.7", 0.26},
         {"8.8", 0.26},  {"8.9", 0.22},  {"8.10", 0.22}, {"9.1", 0.3},   {"9.2", 0.3},   {"9.3", 0.4},
         {"10.1", 0.5},  {"10.2", 0.5},  {"10.3", 0.5},  {"10.4", 0.5},
     };

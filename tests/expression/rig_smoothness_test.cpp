@@ -163,10 +163,15 @@ constexpr double kSinglePoint = 90.0;
 // the still face as a sheet: its weight's fades are smooth products and long
 // (rig.cpp, build_jaw) and the chin drops more than it swings back
 // (kJawGlide). Measured 8 degrees at most for the jaw's FAPs (open_jaw 700)
-// and 11.3 for AU27, whose lip FAPs crowd the lower lip; the max/min weight
-// and the swing alone gave 20-26 (a fold from each mouth corner down towards
-// the chin, surprise's bulge beside the mouth).
-constexpr double kJaw = 14.0;
+// and 15.3 for AU27, whose corner FAPs draw the corners in over the dropped
+// jaw; the max/min weight and the swing alone gave 20-26 (a fold from each
+// mouth corner down towards the chin, surprise's bulge beside the mouth).
+constexpr double kJaw = 17.0;
+// The mouth corners' AUs: the corners' kernels reach the cheek and the jaw's
+// side (rig.cpp, radius_factor), so a corner drawn up (AU12) or out (AU20)
+// moves the skin ahead of it as a sheet: 13.6 and 24.2 degrees; at 0.32 ES0
+// they creased it by 53.7 and 49.8 (the bulges beside fear's corners).
+constexpr double kCorner = 30.0;
 
 std::vector<Case> cases() {
     std::vector<Case> out;
@@ -194,7 +199,9 @@ std::vector<Case> cases() {
         if (au.number >= 51) continue;  // head and gaze: rigid turns
         const bool upper = au.number <= 9 || (au.number >= 41 && au.number <= 46);
         const bool jaw = au.number == 26 || au.number == 27;
-        out.push_back({"AU" + std::to_string(au.number), au.faps, jaw ? kJaw : upper ? kSheet : kSinglePoint});
+        const bool corner = au.number == 12 || au.number == 20;
+        out.push_back({"AU" + std::to_string(au.number), au.faps,
+                       jaw ? kJaw : corner ? kCorner : upper ? kSheet : kSinglePoint});
     }
     // The one-sided brow raise the observers saw tent the forehead.
     FapValues brow{};
