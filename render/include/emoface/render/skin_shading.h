@@ -151,8 +151,8 @@ struct SkinShading {
     float wet_f0 = 0.025f;
     float wet_broad_roughness = 0.45f;
     float wet_broad_weight = 0.1f;
-    float wet_tight_scale = 1.5f;  // the tight lobe's roughness, of the shininess's (Walter et al. 2007)
-    float wet_sheen = 5.0f;        // the lights' reflections on wet parts: the soft boxes' radiance over a point light's
+    float wet_tight_scale = 1.2f;  // the tight lobe's roughness, of the shininess's (Walter et al. 2007)
+    float wet_sheen = 4.0f;        // the lights' reflections on wet parts: the soft boxes' radiance over a point light's
 
     // --- light rig (the key light is the draw's Light, tinted) ---
     glm::vec3 key_tint{1.06f, 0.98f, 0.88f};
