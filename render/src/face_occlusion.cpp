@@ -279,21 +279,25 @@ std::vector<float> bake_face_light_visibility(const expression::TriMesh& mesh, c
     // the 1-ring (about 2 mm each on the default face) round them off.
     constexpr int kSmoothingRounds = 4;
     const std::size_t n = visible.size();
+    std::vector<std::size_t> triangles;
+    triangles.reserve(mesh.n_faces() * 3);
+    for (const auto fh : mesh.faces()) {
+        std::size_t v[3];
+        int k = 0;
+        for (const auto vh : mesh.fv_range(fh))
+            if (k < 3) v[k++] = std::size_t(vh.idx());
+        if (k == 3) triangles.insert(triangles.end(), v, v + 3);
+    }
     std::vector<float> sum(n), count(n);
     for (int round = 0; round < kSmoothingRounds; ++round) {
         std::fill(sum.begin(), sum.end(), 0.0f);
         std::fill(count.begin(), count.end(), 0.0f);
-        for (const auto fh : mesh.faces()) {
-            int v[3], k = 0;
-            for (const auto vh : mesh.fv_range(fh))
-                if (k < 3) v[k++] = vh.idx();
-            if (k != 3) continue;
-            for (int a = 0; a < 3; ++a)
-                for (int b = 0; b < 3; ++b) {
-                    sum[std::size_t(v[a])] += visible[std::size_t(v[b])];
-                    count[std::size_t(v[a])] += 1.0f;
+        for (std::size_t t = 0; t < triangles.size(); t += 3)
+            for (std::size_t a = t; a < t + 3; ++a)
+                for (std::size_t b = t; b < t + 3; ++b) {
+                    sum[triangles[a]] += visible[triangles[b]];
+                    count[triangles[a]] += 1.0f;
                 }
-        }
         for (std::size_t i = 0; i < n; ++i)
             if (count[i] > 0.0f) visible[i] = sum[i] / count[i];
     }

@@ -284,7 +284,6 @@ struct Renderer::Impl {
         // (model space; zero: none).
         std::vector<float> key_visible;
         glm::vec3 key_shadow_toward{0.0f};
-        std::vector<std::uint32_t> triangles;  // kept for painting key_visible into the base UVs
         GLsizei index_count = 0;
         std::size_t vertex_count = 0;
         std::vector<glm::vec2> base_uvs;
@@ -467,7 +466,6 @@ Renderer::MeshId Renderer::add_mesh(const expression::TriMesh& mesh, const Mater
     }
     if (impl_->front_first) order_front_first(mesh, indices);
     m.index_count = GLsizei(indices.size());
-    m.triangles = indices;
     m.base_uvs.assign(m.vertex_count, glm::vec2(0.0f));
     if (mesh.has_vertex_texcoords2D())
         for (const auto vh : mesh.vertices()) {
@@ -697,8 +695,18 @@ void Renderer::draw(const DrawOptions& o, const WrinkleTexture* wrinkle_map) {
             if (!wanted || (m.detail_texture && m.detail_levels == k.albedo_bump_bias &&
                             m.detail_hair == k.hair_luminance))
                 continue;
+            // The triangles that paint the key's shadows into the base UVs:
+            // read back from the index buffer, once per map.
+            std::vector<std::uint32_t> triangles;
+            if (!m.key_visible.empty()) {
+                triangles.resize(std::size_t(m.index_count));
+                glBindBuffer(GL_COPY_READ_BUFFER, m.ebo);
+                glGetBufferSubData(GL_COPY_READ_BUFFER, 0, GLsizeiptr(triangles.size() * sizeof(std::uint32_t)),
+                                   triangles.data());
+                glBindBuffer(GL_COPY_READ_BUFFER, 0);
+            }
             const DetailMap d = upload_detail_map(*m.material.base_texture, k.albedo_bump_bias, k.hair_luminance,
-                                                  m.key_visible, m.base_uvs, m.triangles);
+                                                  m.key_visible, m.base_uvs, triangles);
             if (m.detail_texture) glDeleteTextures(1, &m.detail_texture);
             m.detail_texture = d.texture;
             m.detail_slope_scale = d.slope_scale;
