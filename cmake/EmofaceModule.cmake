@@ -16,7 +16,7 @@ endfunction()
 # emoface_add_test(<name> SOURCES ... DEPS ...): a GoogleTest executable whose
 # tests ctest discovers; the test's working directory is the build tree.
 function(emoface_add_test name)
-  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "" "COST" "SOURCES;DEPS;LABELS" ${ARGN})
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main)
   target_compile_definitions(${name} PRIVATE
@@ -30,6 +30,13 @@ function(emoface_add_test name)
   if("noleak" IN_LIST ARG_LABELS)
     set(env ENVIRONMENT "ASAN_OPTIONS=detect_leaks=0:abort_on_error=1")
   endif()
+  # COST: seconds a test of this binary may take. ctest starts the costly
+  # ones first; CI's fresh build tree has no timings of its own, and a
+  # minute-long test started last ran alone on one of the two cores.
+  set(cost "")
+  if(ARG_COST)
+    set(cost COST ${ARG_COST})
+  endif()
   gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60
-    PROPERTIES LABELS "${ARG_LABELS}" ${env})
+    PROPERTIES LABELS "${ARG_LABELS}" ${env} ${cost})
 endfunction()

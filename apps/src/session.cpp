@@ -121,8 +121,12 @@ morph::Backend parse_backend(const std::string& text, const std::string& command
     fail<InputError>("{}: --backend '{}': expected auto, cpu or cuda", command, text);
 }
 
+namespace {
+bool plays_in_time(const std::string& command) { return command == "play" || command == "view"; }
+}  // namespace
+
 morph::Accuracy morph_accuracy_for(const std::string& command) {
-    return command == "play" || command == "view" ? morph::Accuracy::Fast : morph::Accuracy::Exact;
+    return plays_in_time(command) ? morph::Accuracy::Fast : morph::Accuracy::Exact;
 }
 
 SessionOptions SessionArgs::resolve(const std::string& command, int width, int height) const {
@@ -140,6 +144,7 @@ SessionOptions SessionArgs::resolve(const std::string& command, int width, int h
     else fail<InputError>("{}: --shading '{}': expected skin or thesis", command, shading);
     o.wrinkles = !no_wrinkles;
     o.clamp_faps = !no_clamp;
+    o.light_on_pose = !plays_in_time(command);
     o.width = width;
     o.height = height;
     render::check_wrinkle_map_size(o.wrinkle_size, command + ": --wrinkle-size");
@@ -357,6 +362,7 @@ render::DrawOptions Session::draw_options(float aspect) const {
 render::ImageRGBA8 Session::render_frame(const expression::FaceState& state) {
     const auto t0 = Clock::now();
     const double cpu0 = process_cpu_ms();
+    if (options_.light_on_pose) scene_->bake_light_on_pose(state.faps);
     update(state);
     platform_->begin_frame();
     render::DrawOptions d = draw_options(float(options_.width) / float(options_.height));

@@ -82,6 +82,11 @@ struct SessionOptions {
     // FAPs clamped to the face's range (data/expression/fap_ranges.json);
     // false (--no-clamp) plays a file's values raw.
     bool clamp_faps = true;
+    // The occlusion and the key's shadows baked again on each picture's pose
+    // (FaceScene::bake_light_on_pose: about a second a picture): the
+    // pictures (mix, inspect, morph) do; what plays in time keeps the rest
+    // shape's.
+    bool light_on_pose = false;
 };
 
 // The options every drawing command (play, mix, inspect, morph) and `view`

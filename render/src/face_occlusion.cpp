@@ -142,10 +142,14 @@ std::vector<float> bake_face(const expression::TriMesh& mesh, const expression::
         return out;
     };
 
+    // Where the feature point lies on `mesh`: its vertex, so that a posed
+    // mesh is baked with its posed lips and brows.
     auto point = [&](const char* id, glm::vec3& p) {
         const auto& fp = face.feature_points[std::size_t(fap::feature_point_index(id))];
         if (!fp.present) return false;
-        p = glm::vec3(float(fp.position[0]), float(fp.position[1]), float(fp.position[2]));
+        p = fp.vertex >= 0 && std::size_t(fp.vertex) < n
+                ? positions[std::size_t(fp.vertex)]
+                : glm::vec3(float(fp.position[0]), float(fp.position[1]), float(fp.position[2]));
         return true;
     };
 

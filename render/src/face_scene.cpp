@@ -214,20 +214,6 @@ FaceScene::FaceScene(Platform& platform, const expression::Face& face,
         }
         part.mesh.add_face(h[0], h[1], h[2]);
     }
-    // Ambient occlusion of the rest shape (face_occlusion.h): the skin and the
-    // mouth interior take it (the eyeballs turn away from the rest shape's
-    // occluders, so they keep their own shading).
-    const std::vector<float> occlusion = bake_face_occlusion(mesh_, face);
-    // The portrait key's cast shadows on the rest shape, for the skin. The
-    // key stands for a soft box about 10 degrees in radius (its shadows'
-    // edges blur over a few mm at the nose's and the brows' distance), seen
-    // from 12 directions; the renderer draws them while the key stays near
-    // this direction (renderer.h, set_key_shadow).
-    constexpr float kKeyRadiusDeg = 10.0f;
-    constexpr int kKeySamples = 12;
-    const glm::vec3 toward_key = glm::normalize(glm::vec3(portrait_light().position));
-    const std::vector<float> key_visible =
-        bake_face_light_visibility(mesh_, face, toward_key, kKeyRadiusDeg, kKeySamples);
     const Material* materials[kGroups] = {&options.skin, &options.eyes, &options.mouth};
     for (int g = 0; g < kGroups; ++g) {
         Part& part = parts_[g];
@@ -260,19 +246,12 @@ FaceScene::FaceScene(Platform& platform, const expression::Face& face,
             }
         part.fixed_tangents.assign(part.full_index.size(), glm::vec4(1, 0, 0, 1));
         part.id = renderer_->add_mesh(part.mesh, m);
-        if (g != kEyes) {
-            auto of_part = [&](const std::vector<float>& whole) {
-                std::vector<float> values(part.full_index.size());
-                for (std::size_t i = 0; i < values.size(); ++i) values[i] = whole[std::size_t(part.full_index[i])];
-                return values;
-            };
-            renderer_->set_occlusion(part.id, of_part(occlusion));
-            renderer_->set_key_shadow(part.id, of_part(key_visible), toward_key);
-        }
         // Parts the CPU gives no frames to: constant ones, uploaded once.
         if (!part.wrinkles || frames_ == WrinkleFrames::Shader)
             renderer_->update_mesh(part.id, part.mesh, part.wrinkle_uvs, part.fixed_tangents);
     }
+
+    bake_light(mesh_, false);
 
     const bool gpu_geometry =
         options.geometry == GeometryDevice::Gpu ||
@@ -456,6 +435,53 @@ void FaceScene::update_wrinkles(const std::vector<float>& key_weights) {
     const auto t = Clock::now();
     wrinkle_morph_->update(target_, key_weights, params_);
     times_.morph_ms = ms_since(t);
+}
+
+void FaceScene::bake_light(const expression::TriMesh& shape, bool on_pose) {
+    // Ambient occlusion (face_occlusion.h): the skin and the mouth interior
+    // take it (the eyeballs turn away from the rest shape's occluders, so
+    // they keep their own shading).
+    const std::vector<float> occlusion = bake_face_occlusion(shape, face_);
+    // The portrait key's cast shadows, for the skin. The key stands for a
+    // soft box about 16 degrees in radius (a portrait's large box), seen
+    // from 16 directions: its shadows' edges blur over a few mm at the
+    // nose's and the brows' distance (at 10 degrees the nose's shadow edge
+    // and the glabella's on the nasion read as drawn lines: blind review,
+    // round 14). The renderer draws them while the key stays near this
+    // direction (renderer.h, set_key_shadow).
+    constexpr float kKeyRadiusDeg = 16.0f;
+    constexpr int kKeySamples = 16;
+    const glm::vec3 toward_key = glm::normalize(glm::vec3(portrait_light().position));
+    const std::vector<float> key_visible =
+        bake_face_light_visibility(shape, face_, toward_key, kKeyRadiusDeg, kKeySamples);
+    for (int g = 0; g < kGroups; ++g) {
+        const Part& part = parts_[std::size_t(g)];
+        if (part.id < 0 || g == kEyes) continue;
+        auto of_part = [&](const std::vector<float>& whole) {
+            std::vector<float> values(part.full_index.size());
+            for (std::size_t i = 0; i < values.size(); ++i) values[i] = whole[std::size_t(part.full_index[i])];
+            return values;
+        };
+        std::vector<float> open = of_part(occlusion);
+        if (g == kMouth && on_pose) {
+            // The mouth interior has no relief map to carry the key's
+            // shadows: they dim its occlusion instead (which shades it from
+            // every light), by the key's share of its light. Only on the
+            // pose: at rest the closed lips hide it from the key entirely.
+            constexpr float kKeyShare = 0.7f;
+            const std::vector<float> visible = of_part(key_visible);
+            for (std::size_t i = 0; i < open.size(); ++i) open[i] *= 1.0f - kKeyShare * (1.0f - visible[i]);
+        }
+        renderer_->set_occlusion(part.id, open);
+        renderer_->set_key_shadow(part.id, of_part(key_visible), toward_key);
+    }
+}
+
+void FaceScene::bake_light_on_pose(const expression::FapValues& faps) {
+    platform_.make_current();
+    expression::TriMesh posed = face_.mesh;
+    expression::FaceRig::write_to(rig_.deform(faps), posed);
+    bake_light(posed, true);
 }
 
 void FaceScene::update_geometry(const expression::FapValues& faps) {

@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "emoface/expression/default_face.h"
+#include "emoface/expression/rig.h"
 #include "emoface/fap/feature_points.h"
 #include "emoface/render/ambient_occlusion.h"
 #include "emoface/render/face_occlusion.h"
@@ -220,6 +221,42 @@ TEST(FaceOcclusion, PortraitKeysShadowFallsBesideTheNoseAndUnderTheJaw) {
     EXPECT_GT(front(0.0f, 50.0f), 0.95f) << "the forehead";
     EXPECT_LT(front(0.0f, -120.0f), 0.5f) << "the neck under the jaw";
     EXPECT_GT(front(-40.0f, -20.0f), 0.95f) << "the cheek on the key's side";
+}
+
+// On a pose (FaceScene::bake_light_on_pose): with the jaw dropped, the key
+// reaches into the open mouth, which the closed lips hide at rest, and the
+// lips are baked where they are (their feature points read from the posed
+// mesh): the lower lip's inner face, open to the key, stays lit.
+TEST(FaceOcclusion, APosedBakeSeesIntoTheOpenMouth) {
+    const Baked& b = baked();
+    const glm::vec3 toward_key = glm::normalize(glm::vec3(-0.62f, 0.62f, 0.48f));
+    const ex::FaceRig rig(b.face);
+    ex::FapValues faps{};
+    faps[2] = 900.0;  // FAP 3 open_jaw, about 30 mm: AU26 + AU27
+    ex::TriMesh posed = b.face.mesh;
+    ex::FaceRig::write_to(rig.deform(faps), posed);
+    const std::vector<float> at_rest =
+        emoface::render::bake_face_light_visibility(b.mesh, b.face, toward_key, 10.0f, 12);
+    const std::vector<float> on_pose =
+        emoface::render::bake_face_light_visibility(posed, b.face, toward_key, 10.0f, 12);
+    // The lower incisors and the tongue's front: interior vertices within
+    // 15 mm behind the lower lip's inner contour (2.3) and below it.
+    const auto& lip = posed.point(posed.vertex_handle(vertex_of("2.3")));
+    double rest_sum = 0.0, pose_sum = 0.0;
+    int count = 0;
+    for (const auto vh : posed.vertices()) {
+        const auto part = b.face.parts[std::size_t(vh.idx())];
+        if (part != ex::VertexPart::MouthLower && part != ex::VertexPart::Tongue) continue;
+        const auto& p = posed.point(vh);
+        if (std::abs(p[0] - lip[0]) > 12.0f || lip[2] - p[2] > 15.0f || p[1] > lip[1] + 2.0f) continue;
+        rest_sum += at_rest[std::size_t(vh.idx())];
+        pose_sum += on_pose[std::size_t(vh.idx())];
+        ++count;
+    }
+    ASSERT_GT(count, 5) << "interior vertices behind the lower lip";
+    EXPECT_GT(pose_sum / count, rest_sum / count + 0.25)
+        << "open, the key reaches into the mouth (at rest " << rest_sum / count << ")";
+    EXPECT_GT(on_pose[std::size_t(vertex_of("2.3"))], 0.6f) << "the lower lip's inner contour, open to the key";
 }
 
 }  // namespace

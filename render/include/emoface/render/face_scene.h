@@ -157,6 +157,13 @@ public:
     void update_geometry(const expression::FapValues& faps);
     // The wrinkle half: the morph onto the current L* into the texture.
     void update_wrinkles(const std::vector<float>& key_weights);
+    // The ambient occlusion and the key's cast shadows, baked again on the
+    // shape `faps` pose (about a second on the default face). The scene
+    // bakes them on the rest shape, and the skin carries them along: right
+    // for the small motions of speech, but in a held expression a shadow
+    // rides on skin that moved out of it (the nose's shadow onto joy's
+    // raised cheek, a dark gash beside the nose). For still pictures.
+    void bake_light_on_pose(const expression::FapValues& faps);
 
     // Draws the three meshes (options.wrinkles false: without the wrinkle map).
     // With frames_in_flight() 2: the frame of the update() before the last
@@ -211,6 +218,10 @@ private:
     // points when asked (projective layout; the anchored L* never moves).
     void deform(const expression::FapValues& faps, bool layout_from_mesh);
     void deform_on_gpu(const expression::FapValues& faps, bool layout_from_mesh);
+    // Bakes the occlusion and the key's shadows on `shape` (the full mesh,
+    // with normals) into the skin's and the mouth's meshes; `on_pose`: the
+    // shape is the pose drawn, not the rest shape.
+    void bake_light(const expression::TriMesh& shape, bool on_pose);
     // update() with the morph and the geometry both on CUDA: one mapping for both.
     void update_on_gpu(const expression::FapValues& faps, const std::vector<float>& key_weights);
     // CudaGeometry::run into the mapped vertex buffers (GlBufferInterop's order).
