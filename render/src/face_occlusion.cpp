@@ -281,7 +281,7 @@ std::vector<float> bake_face_light_visibility(const expression::TriMesh& mesh, c
     // shadow's edge: along the neck, under the jaw's shadow, the steps drew
     // light streaks down the skin at 512 px. A few rounds of averaging with
     // the 1-ring (about 2 mm each on the default face) round them off.
-    constexpr int kSmoothingRounds = 4;
+    constexpr int kSmoothingRounds = 8;
     const std::size_t n = visible.size();
     std::vector<std::size_t> triangles;
     triangles.reserve(mesh.n_faces() * 3);

@@ -365,8 +365,8 @@ TEST(FaceTexture, AlphaHoldsTheRegionsRoughness) {
     const double crown = texel_of(f.feature_points[fap::feature_point_index("11.4")].vertex).a;
     EXPECT_NEAR(cheek, 1.0, 0.02);
     EXPECT_NEAR(crown, 1.0, 0.02);
-    EXPECT_LT(lips, cheek - 0.1);
-    // The T-zone scale is 0.93 (face.json roughness); this point of the
+    EXPECT_LT(lips, cheek - 0.07) << "the lips glossier than the cheek (0.85, broken up towards 1)";
+    // The T-zone scale is 0.88 (face.json roughness); this point of the
     // nose takes 0.4 of it.
     EXPECT_LT(nose, cheek - 0.02);
 }

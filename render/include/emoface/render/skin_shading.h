@@ -114,7 +114,7 @@ struct SkinShading {
     // matte_sheen at g = 1 up to 1 at g <= full_sheen_gloss (the T-zone,
     // lips, lid margins).
     float gloss_exponent = 2.0f;
-    float matte_sheen = 0.4f;
+    float matte_sheen = 0.55f;
     float full_sheen_gloss = 0.8f;
 
     // --- baked ambient occlusion (ambient_occlusion.h): how far it dims ---
