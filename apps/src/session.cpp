@@ -144,7 +144,8 @@ SessionOptions SessionArgs::resolve(const std::string& command, int width, int h
     else fail<InputError>("{}: --shading '{}': expected skin or thesis", command, shading);
     o.wrinkles = !no_wrinkles;
     o.clamp_faps = !no_clamp;
-    o.light_on_pose = !plays_in_time(command);
+    // Thesis shading has neither the occlusion nor the key's shadows.
+    o.light_on_pose = !plays_in_time(command) && o.shading == render::Shading::Skin;
     o.width = width;
     o.height = height;
     render::check_wrinkle_map_size(o.wrinkle_size, command + ": --wrinkle-size");

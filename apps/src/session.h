@@ -84,8 +84,8 @@ struct SessionOptions {
     bool clamp_faps = true;
     // The occlusion and the key's shadows baked again on each picture's pose
     // (FaceScene::bake_light_on_pose: about a second a picture): the
-    // pictures (mix, inspect, morph) do; what plays in time keeps the rest
-    // shape's.
+    // pictures (mix, inspect; morph's thesis shading has neither) do; what
+    // plays in time keeps the rest shape's.
     bool light_on_pose = false;
 };
 
