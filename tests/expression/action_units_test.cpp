@@ -152,10 +152,10 @@ TEST(ActionUnits, BilateralHalvesStayOnTheirSideAndSumToTheWhole) {
 TEST(EmotionPrototypes, AreTheFacsPrototypesAndTheirFapsAreTheSumOfTheirAus) {
     struct Case {
         Emotion emotion;
-        std::set<int> aus;  // EMFACS short codes (sadness adds 64, from the Investigator's Guide's variants)
+        std::set<int> aus;  // EMFACS short codes (sadness adds 64, from the Investigator's Guide's variants, and 41)
     } cases[] = {
         {Emotion::Joy, {6, 12}},
-        {Emotion::Sadness, {1, 4, 15, 64}},
+        {Emotion::Sadness, {1, 4, 15, 41, 64}},
         {Emotion::Surprise, {1, 2, 5, 26}},
         {Emotion::Fear, {1, 2, 4, 5, 7, 20, 26}},
         {Emotion::Anger, {4, 5, 7, 23}},
