@@ -111,9 +111,9 @@ TEST_P(EachFap, MovesItsFeaturePointAlongTheTableDirectionAndNothingFar) {
         EXPECT_GT(d.feature_points[fp("6.4")][1] - face.position(fp("6.4"))[1], 0.1);
     } else {
         const double along = dot(moved, info.direction);
-        // The cheek point lies in the apple of the cheek's reach, which holds
-        // its rise back by a tenth of its share there (rig.cpp, kMassUp).
-        EXPECT_NEAR(along, expected, (f == 41 || f == 42 ? 0.07 : 0.02) * std::abs(expected) + 1e-4);
+        // The cheek point lies near the top of the apple of the cheek, which
+        // holds its rise back by a fifth of its share there (rig.cpp, kMassUp).
+        EXPECT_NEAR(along, expected, (f == 41 || f == 42 ? 0.2 : 0.02) * std::abs(expected) + 1e-4);
         Vec3d across = moved;
         for (int c = 0; c < 3; ++c) across[c] -= along * info.direction[c];
         // Lids slide over the eyeball, which moves them in z as well; a
@@ -124,7 +124,7 @@ TEST_P(EachFap, MovesItsFeaturePointAlongTheTableDirectionAndNothingFar) {
         double allowed = 0.05;
         if (f >= 19 && f <= 22) allowed = 0.7;
         if (f == 6 || f == 7 || f == 53 || f == 54) allowed = 0.7;
-        if (f == 41 || f == 42) allowed = 0.3;
+        if (f == 41 || f == 42) allowed = 0.46;  // at most the apple's whole forward and outward share
         EXPECT_LT(norm(across), allowed * std::abs(expected) + 1e-4);
     }
 
