@@ -3,16 +3,24 @@
 // half size with small committed PNGs in goldens/. On a mismatch the test
 // writes the actual and an amplified difference image into the build tree
 // (golden-failures/); scripts/update-goldens rewrites the goldens for review.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
 #include <string>
 
+#include <glm/common.hpp>
+#include <glm/mat4x4.hpp>
+#include <glm/vec2.hpp>
+#include <glm/vec4.hpp>
 #include <gtest/gtest.h>
 
 #include "emoface/expression/emotion.h"
 #include "emoface/expression/face_state.h"
 #include "emoface/fap/fap_io.h"
+#include "emoface/fap/feature_points.h"
 #include "emoface/render/face_assets.h"
 #include "emoface/render/image_diff.h"
 #include "emoface/render/platform.h"
@@ -138,6 +146,60 @@ TEST_F(Golden, ToleranceSeparatesWrinklesFromNoWrinkles) {
     const render::ImageDiff diff = render::diff_images(with, without);
     std::printf("anger with vs without wrinkles: mean %.3f, max %d\n", diff.mean_diff, diff.max_channel_diff);
     EXPECT_GT(diff.mean_diff, 2.0 * kFaceTolerance.mean_diff);
+}
+
+// The pictures bake their light on their own pose (FaceScene::
+// bake_light_on_pose, as `mix` does): on the rest pose that is the scene's
+// own bake, the same picture; on surprise's open mouth it sees the inside,
+// which the rest shape's bake saw only through the closed lips (its own
+// occlusion and the key through the opening: the tongue and lower teeth
+// change by far more than the goldens' tolerance).
+TEST_F(Golden, LightBakedOnThePoseFollowsTheOpenMouth) {
+    const expression::FaceState neutral =
+        expression::face_state(expression::parse_emotion_mix("neutral"), assets_->emotions);
+    const render::ImageRGBA8 rest = draw(neutral);
+    scene_->bake_light_on_pose(neutral.faps);
+    const render::ImageDiff same = render::diff_images(rest, draw(neutral));
+    EXPECT_LE(same.max_channel_diff, 2) << "the rest pose's bake is the scene's own";
+
+    const expression::FaceState surprise =
+        expression::face_state(expression::parse_emotion_mix("surprise"), assets_->emotions);
+    const render::ImageRGBA8 rest_lit = draw(surprise);
+    scene_->bake_light_on_pose(surprise.faps);
+    const render::ImageRGBA8 pose_lit = draw(surprise);
+    // The mouth's opening on the (half-size) picture: between the inner lip
+    // contour's top and bottom (2.2, 2.3) and a third of the way to the
+    // corners (2.4, 2.5).
+    const auto points = assets_->rig->feature_points(surprise.faps);
+    const glm::mat4 m = scene_->frontal_camera(1.0f).projection * scene_->frontal_camera(1.0f).view;
+    auto pixel = [&](const char* id) {
+        const auto& p = points[std::size_t(fap::feature_point_index(id))];
+        const glm::vec4 c = m * glm::vec4(float(p[0]), float(p[1]), float(p[2]), 1.0f);
+        return glm::vec2((c.x / c.w * 0.5f + 0.5f) * float(rest_lit.width),
+                         (0.5f - c.y / c.w * 0.5f) * float(rest_lit.height));
+    };
+    const glm::vec2 top = pixel("2.2"), bottom = pixel("2.3"), left = pixel("2.4"), right = pixel("2.5");
+    ASSERT_GT(bottom.y - top.y, 6.0f) << "surprise opens the mouth";
+    const float half_width = std::abs(right.x - left.x) / 6.0f;
+    // Mean grey over the opening's rows from `from` to `to` (0 top, 1 bottom).
+    auto mean_inside = [&](const render::ImageRGBA8& image, float from, float to) {
+        double sum = 0.0;
+        int n = 0;
+        const float cx = 0.5f * (top.x + bottom.x);
+        for (int y = int(glm::mix(top.y, bottom.y, from)); y < int(glm::mix(top.y, bottom.y, to)); ++y)
+            for (int x = int(cx - half_width); x <= int(cx + half_width); ++x) {
+                const std::uint8_t* px = &image.pixels[(std::size_t(y) * std::size_t(image.width) + std::size_t(x)) * 4];
+                sum += px[0] + px[1] + px[2];
+                ++n;
+            }
+        return sum / (3.0 * std::max(n, 1));
+    };
+    const double upper_before = mean_inside(rest_lit, 0.0f, 0.35f), upper_after = mean_inside(pose_lit, 0.0f, 0.35f);
+    const double lower_before = mean_inside(rest_lit, 0.55f, 0.95f), lower_after = mean_inside(pose_lit, 0.55f, 0.95f);
+    std::printf("surprise's open mouth, rest shape's light -> its own: upper part %.1f -> %.1f, lower part %.1f -> %.1f\n",
+                upper_before, upper_after, lower_before, lower_after);
+    EXPECT_GT(std::abs(lower_after - lower_before), 5.0) << "the open mouth's inside, baked on its pose";
+    scene_->bake_light_on_pose(neutral.faps);
 }
 
 }  // namespace
