@@ -406,12 +406,22 @@ float stroke_height(const Stroke& s, const FoldShape& shape, float unit, glm::ve
                                           bump(best - shape.shoulder_offset * flank, shape.shoulder_width * flank));
         case WrinkleProfile::Bulge:
             return depth * bump(best, sigma);
-        case WrinkleProfile::Fold:
-            // The cheek rounds broadly over the `side` flank; the other keeps a small shoulder.
-            return depth * (-valley + 0.55f * bump(s.side * signed_best - 2.5f * sigma, 2.0f * sigma) +
+        case WrinkleProfile::Fold: {
+            // The cheek rounds broadly over the `side` flank; the other keeps
+            // a small shoulder. The cheek's rise reaches 8 sigma out, so it
+            // fades in over at least kRiseTaper of the fold's length: faded
+            // in over the valley's short taper (a nasolabial fold starts
+            // deep at the nose wing), its edge ran from the fold's top out
+            // across the cheek as a line (joy: a streak from the nose wing
+            // towards the outer eye corner, blind review round 14).
+            constexpr float kRiseTaper = 0.4f;
+            const float valley_fade = s.taper > 0.0f ? smoothstep01(u / s.taper) : 1.0f;  // in `window`
+            const float rise = std::min(smoothstep01(u / std::max(s.taper, kRiseTaper)) / valley_fade, 1.0f);
+            return depth * (-valley + 0.55f * rise * bump(s.side * signed_best - 2.5f * sigma, 2.0f * sigma) +
                             0.5f * s.shoulder *
                                 bump(-s.side * signed_best - shape.shoulder_offset * flank,
                                      shape.shoulder_width * flank));
+        }
     }
     return 0.0f;
 }
