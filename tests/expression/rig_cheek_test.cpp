@@ -8,6 +8,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,16 @@ using testing::to_vec;
 const EmotionProfiles& profiles() {
     static const EmotionProfiles p = load_emotion_profiles(std::string(EMOFACE_DATA_DIR) + "/expression/emotions.json");
     return p;
+}
+
+// The FAPs of the AUs `numbers` at full intensity, summed (AU6 + AU12: the smile without an emotion's other AUs).
+FapValues au(std::initializer_list<int> numbers) {
+    FapValues sum{};
+    for (const int n : numbers) {
+        const FapValues& faps = profiles().action_units.find(n)->faps;
+        for (std::size_t i = 0; i < sum.size(); ++i) sum[i] += faps[i];
+    }
+    return sum;
 }
 
 struct CheekReading {
@@ -68,23 +79,21 @@ TEST(RigCheek, ASmileBringsTheCheekForwardAndUpBesideADeeperFold) {
         FapValues faps;
         double forward_min, forward_max, fold_min;
     };
-    const ActionUnitTable& aus = profiles().action_units;
-    auto au = [&](int n) { return aus.find(n)->faps; };
     const Case cases[] = {
         // The Duchenne smile: the cheek 3-6 mm forward, the fold 2 mm deeper.
         {"joy", profiles()[Emotion::Joy], 3.0, 6.5, 2.0},
-        {"AU6 cheek raiser", au(6), 2.0, 5.0, 1.5},
-        {"AU12 lip corner puller", au(12), 1.0, 4.0, 0.5},
+        {"AU6 cheek raiser", au({6}), 2.0, 5.0, 1.5},
+        {"AU12 lip corner puller", au({12}), 1.0, 4.0, 0.5},
         // Disgust's nose wrinkler and the upper lip raiser lift it a little
         // (the infraorbital triangle goes up with the lip).
         {"disgust", profiles()[Emotion::Disgust], 0.7, 2.5, 0.5},
-        {"AU9 nose wrinkler", au(9), 0.7, 2.5, 0.5},
-        {"AU10 upper lip raiser", au(10), 0.5, 2.0, 0.3},
+        {"AU9 nose wrinkler", au({9}), 0.7, 2.5, 0.5},
+        {"AU10 upper lip raiser", au({10}), 0.5, 2.0, 0.3},
         // Nothing lifts the cheek or the corners: it stays.
-        {"AU15 lip corner depressor", au(15), -0.3, 0.3, -1.0},
-        {"AU20 lip stretcher", au(20), -0.3, 0.3, -1.0},
-        {"AU4 brow lowerer", au(4), -0.3, 0.3, -1.0},
-        {"AU7 lid tightener", au(7), -0.3, 0.3, -1.0},
+        {"AU15 lip corner depressor", au({15}), -0.3, 0.3, -1.0},
+        {"AU20 lip stretcher", au({20}), -0.3, 0.3, -1.0},
+        {"AU4 brow lowerer", au({4}), -0.3, 0.3, -1.0},
+        {"AU7 lid tightener", au({7}), -0.3, 0.3, -1.0},
         // Nor do the emotions without AU6, AU9, AU10 or AU12.
         {"sadness", profiles()[Emotion::Sadness], -0.3, 0.3, -1.0},
         {"fear", profiles()[Emotion::Fear], -0.3, 0.3, -1.0},
@@ -159,22 +168,18 @@ double largest_cheek_crease(const FapValues& faps, bool left, Vec3d* where, doub
 }
 
 TEST(RigCheek, TheSmilingCheekHasNoRidgeDownIt) {
-    const ActionUnitTable& aus = profiles().action_units;
-    auto au = [&](int n) { return aus.find(n)->faps; };
-    FapValues au6_12 = au(6);
-    for (std::size_t i = 0; i < au6_12.size(); ++i) au6_12[i] += au(12)[i];
     struct Case {
         std::string what;
         FapValues faps;
     };
     const Case cases[] = {
         {"joy", profiles()[Emotion::Joy]},
-        {"AU6 cheek raiser", au(6)},
-        {"AU12 lip corner puller", au(12)},
-        {"AU6+AU12", au6_12},
+        {"AU6 cheek raiser", au({6})},
+        {"AU12 lip corner puller", au({12})},
+        {"AU6+AU12", au({6, 12})},
         {"disgust", profiles()[Emotion::Disgust]},
-        {"AU9", au(9)},
-        {"AU10", au(10)},
+        {"AU9", au({9})},
+        {"AU10", au({10})},
     };
     // Between triangles of about 2.5 mm (the half-resolution test face) the
     // mound bends each edge by up to about 7 degrees; the ridge along the
@@ -199,12 +204,8 @@ TEST(RigCheek, TheSmilingCheekHasNoRidgeDownIt) {
 // over 0.45 ES0; 5.3 and 6.4 with the round bell over 0.55 (rig.cpp,
 // kMassRadius); 5.5 and 6.7 centred under the eye over 0.65 (round 14).
 TEST(RigCheek, TheSmilingCheekRisesAsOneRoundMass) {
-    const ActionUnitTable& aus = profiles().action_units;
-    auto au = [&](int n) { return aus.find(n)->faps; };
-    FapValues au6_12 = au(6);
-    for (std::size_t i = 0; i < au6_12.size(); ++i) au6_12[i] += au(12)[i];
     const std::pair<std::string, FapValues> cases[] = {
-        {"joy", profiles()[Emotion::Joy]}, {"AU6+AU12", au6_12}, {"AU6 cheek raiser", au(6)}, {"AU12", au(12)}};
+        {"joy", profiles()[Emotion::Joy]}, {"AU6+AU12", au({6, 12})}, {"AU6 cheek raiser", au({6})}, {"AU12", au({12})}};
     for (const auto& [what, faps] : cases)
         for (const bool left : {true, false}) {
             Vec3d at{};
@@ -304,10 +305,6 @@ double deepest_valley_nose_to_eye(const FapValues& faps, bool left, Vec3d* where
 // stayed behind (rig.cpp, kCentreOnCheekbone); the bounds below hold the
 // apple centred on the cheekbone.
 TEST(RigCheek, NoGullyRunsFromTheNoseWingToTheOuterEye) {
-    const ActionUnitTable& aus = profiles().action_units;
-    auto au = [&](int n) { return aus.find(n)->faps; };
-    FapValues au6_12 = au(6);
-    for (std::size_t i = 0; i < au6_12.size(); ++i) au6_12[i] += au(12)[i];
     struct Case {
         std::string what;
         FapValues faps;
@@ -318,11 +315,11 @@ TEST(RigCheek, NoGullyRunsFromTheNoseWingToTheOuterEye) {
         // centred 0.6 of the way to the cheekbone over 0.55 ES0; 0.6 and 0.8
         // now.
         {"joy", profiles()[Emotion::Joy], 0.8},
-        {"AU6+AU12", au6_12, 1.0},
+        {"AU6+AU12", au({6, 12}), 1.0},
         // The cheek raised alone, without the corners' share of the mass:
         // 2.1-2.3 mm before, 1.3 now.
-        {"AU6 cheek raiser", au(6), 1.5},
-        {"AU12", au(12), 0.3},
+        {"AU6 cheek raiser", au({6}), 1.5},
+        {"AU12", au({12}), 0.3},
         // Disgust's upper lip lifts the mass a little: 0.9 mm before, 0.4 now.
         {"disgust", profiles()[Emotion::Disgust], 0.6},
     };
