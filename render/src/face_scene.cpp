@@ -467,7 +467,8 @@ void FaceScene::bake_light(const expression::TriMesh& shape, bool on_pose) {
             // The mouth interior has no relief map to carry the key's
             // shadows: they dim its occlusion instead (which shades it from
             // every light), by the key's share of its light. Only on the
-            // pose: at rest the closed lips hide it from the key entirely.
+            // pose: at rest the lips are closed over it, and what the key's
+            // bake says of it there does not hold once the mouth opens.
             constexpr float kKeyShare = 0.7f;
             const std::vector<float> visible = of_part(key_visible);
             for (std::size_t i = 0; i < open.size(); ++i) open[i] *= 1.0f - kKeyShare * (1.0f - visible[i]);
