@@ -8,6 +8,7 @@
 
 #include "emoface/fap/feature_points.h"
 #include "emoface/render/ambient_occlusion.h"
+#include "mesh_triangles.h"
 
 namespace emoface::render {
 namespace {
@@ -95,15 +96,8 @@ std::vector<float> bake_face(const expression::TriMesh& mesh, const expression::
         positions[std::size_t(vh.idx())] = {p[0], p[1], p[2]};
         normals[std::size_t(vh.idx())] = {nv[0], nv[1], nv[2]};
     }
-    std::vector<unsigned> triangles;
-    triangles.reserve(mesh.n_faces() * 3);
-    for (const auto fh : mesh.faces()) {
-        unsigned v[3];
-        int k = 0;
-        for (const auto vh : mesh.fv_range(fh))
-            if (k < 3) v[k++] = unsigned(vh.idx());
-        if (k == 3) triangles.insert(triangles.end(), v, v + 3);
-    }
+    const std::vector<int> indices = triangle_indices(mesh);
+    std::vector<unsigned> triangles(indices.begin(), indices.end());
     {
         const std::vector<char> strand = strand_triangles(triangles, n, face.parts);
         std::vector<unsigned> solid;
@@ -283,15 +277,7 @@ std::vector<float> bake_face_light_visibility(const expression::TriMesh& mesh, c
     // the 1-ring (about 2 mm each on the default face) round them off.
     constexpr int kSmoothingRounds = 8;
     const std::size_t n = visible.size();
-    std::vector<std::size_t> triangles;
-    triangles.reserve(mesh.n_faces() * 3);
-    for (const auto fh : mesh.faces()) {
-        std::size_t v[3];
-        int k = 0;
-        for (const auto vh : mesh.fv_range(fh))
-            if (k < 3) v[k++] = std::size_t(vh.idx());
-        if (k == 3) triangles.insert(triangles.end(), v, v + 3);
-    }
+    const std::vector<int> triangles = triangle_indices(mesh);
     std::vector<float> sum(n), count(n);
     for (int round = 0; round < kSmoothingRounds; ++round) {
         std::fill(sum.begin(), sum.end(), 0.0f);
@@ -299,8 +285,8 @@ std::vector<float> bake_face_light_visibility(const expression::TriMesh& mesh, c
         for (std::size_t t = 0; t < triangles.size(); t += 3)
             for (std::size_t a = t; a < t + 3; ++a)
                 for (std::size_t b = t; b < t + 3; ++b) {
-                    sum[triangles[a]] += visible[triangles[b]];
-                    count[triangles[a]] += 1.0f;
+                    sum[std::size_t(triangles[a])] += visible[std::size_t(triangles[b])];
+                    count[std::size_t(triangles[a])] += 1.0f;
                 }
         for (std::size_t i = 0; i < n; ++i)
             if (count[i] > 0.0f) visible[i] = sum[i] / count[i];
