@@ -562,6 +562,48 @@ TEST_P(EveryKey, SlopesStaySkinLike) {
         << GetParam() << " has a wall as steep as an engraved line";
 }
 
+// A fold's valley starts deep (a nasolabial fold at the nose wing), but the
+// broad rise of the skin over its side fades in over 40 % of its length: its
+// edge, 8 widths out, faded in over the valley's short taper, ran from the
+// fold's top across the cheek as a line (joy's streak from the nose wing
+// towards the outer eye corner, blind review round 14).
+TEST(FoldShape, TheRiseBesideAFoldFadesInSlowerThanItsValley) {
+    WrinkleLibrarySpec library = spec();
+    WrinkleSpec w;
+    w.name = "test fold";
+    w.profile = WrinkleProfile::Fold;
+    w.depth = 0.02f;
+    w.width = 0.025f;
+    w.taper = 0.12f;
+    w.shoulder = 0.0f;  // the rise alone on the raised side
+    w.points = {AnchoredPoint{fap::feature_point_index("3.12"), -1, 0.5f, {0.0f, -0.35f}},
+                AnchoredPoint{fap::feature_point_index("3.7"), -1, 0.5f, {0.0f, -0.35f}}};
+    library.action_units = {AuWrinkles{12, {}, {}, {w}}};  // across both halves
+    const FeatureLayout& layout = key_layout("joy");
+    constexpr int kSize = 512;
+    const std::vector<float> height = render_height_field(library, {{12, AuSide::Both, 1.0f}}, layout, kSize);
+    // The valley's depth and the rise's height down the column t of the way along the fold.
+    const glm::vec2 a = layout.at("3.12"), b = layout.at("3.7");
+    struct Column {
+        float valley = 0.0f, rise = 0.0f;
+    };
+    const auto column_at = [&](float t) {
+        const int col = static_cast<int>((a.x + t * (b.x - a.x)) * kSize);
+        Column c;
+        for (int r = 0; r < kSize; ++r) {
+            c.valley = std::max(c.valley, -height[r * kSize + col]);
+            c.rise = std::max(c.rise, height[r * kSize + col]);
+        }
+        return c;
+    };
+    const Column near_top = column_at(0.1f), middle = column_at(0.5f);
+    std::printf("fold at 0.1 of its length: valley %.3f, rise %.3f of the middle's\n", near_top.valley / middle.valley,
+                near_top.rise / middle.rise);
+    ASSERT_GT(middle.rise, 0.0f);
+    EXPECT_GT(near_top.valley, 0.5f * middle.valley) << "the valley starts deep";
+    EXPECT_LT(near_top.rise, 0.3f * middle.rise) << "the rise beside it is still fading in";
+}
+
 // A line with a long end taper (crow's feet) is deepest near its start and
 // fades out towards its end.
 TEST(FoldShape, TaperEndFadesTheLineOutwards) {

@@ -259,4 +259,29 @@ TEST(FaceOcclusion, APosedBakeSeesIntoTheOpenMouth) {
     EXPECT_GT(on_pose[std::size_t(vertex_of("2.3"))], 0.6f) << "the lower lip's inner contour, open to the key";
 }
 
+// The bake finds the lips and brows (feature points) on the mesh it bakes:
+// a posed mesh is baked as a face whose feature points stand where the pose
+// put them, not where they were at rest.
+TEST(FaceOcclusion, APosedMeshIsBakedWithItsPosedFeaturePoints) {
+    const Baked& b = baked();
+    const ex::FaceRig rig(b.face);
+    ex::FapValues faps{};
+    faps[2] = 500.0;   // FAP 3 open_jaw: the lips part
+    faps[30] = 200.0;  // FAP 31 raise_l_i_eyebrow
+    ex::TriMesh posed = b.face.mesh;
+    ex::FaceRig::write_to(rig.deform(faps), posed);
+    ex::Face posed_face = b.face;
+    for (auto& fp : posed_face.feature_points)
+        if (fp.present && fp.vertex >= 0) {
+            const auto& p = posed.point(posed.vertex_handle(fp.vertex));
+            fp.position = {p[0], p[1], p[2]};
+        }
+    const std::vector<float> as_given = bake_face_occlusion(posed, b.face);
+    const std::vector<float> as_posed = bake_face_occlusion(posed, posed_face);
+    ASSERT_EQ(as_given.size(), as_posed.size());
+    int differ = 0;
+    for (std::size_t v = 0; v < as_given.size(); ++v) differ += as_given[v] != as_posed[v];
+    EXPECT_EQ(differ, 0) << "vertices baked with the rest shape's lips or brows";
+}
+
 }  // namespace
