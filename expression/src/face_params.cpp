@@ -166,6 +166,7 @@ FaceParams read_face_params(const std::string& params_dir) {
             p.lid_thickness = r.number("lid_thickness");
             p.lid_blend_inner = r.number("lid_blend_inner");
             p.lid_blend_outer = r.number("lid_blend_outer");
+            p.lid_rise = r.number_in("lid_rise", 0.0, 0.5);
             p.lid_warp_reach = r.number("lid_warp_reach");
             p.sclera_corner_tint = r.number_in("sclera_corner_tint", 0.0, 1.0);
             p.sclera_vessels = r.number_in("sclera_vessels", 0.0, 1.0);

@@ -135,6 +135,7 @@ struct FaceParams {
     double upper_lid_peak = 0.5, lower_lid_peak = 0.5;
     double lid_clearance = 0.0, lid_thickness = 0.0;
     double lid_blend_inner = 0.0, lid_blend_outer = 0.0;
+    double lid_rise = 0.0;  // how the lid's skin leaves the eyeball: mm per mm^2 from the margin
     double lid_warp_reach = 0.0;
     // the eyeball's colour (eye_texture.cpp): 0..1 strengths
     double sclera_corner_tint = 0.0, sclera_vessels = 0.0, lid_shadow = 0.0;

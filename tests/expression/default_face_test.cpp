@@ -15,6 +15,7 @@
 #include "emoface/common/error.h"
 #include "emoface/expression/default_face.h"
 #include "emoface/fap/feature_points.h"
+#include "face_shape.h"
 #include "test_face.h"
 
 namespace emoface::expression {
@@ -363,6 +364,36 @@ TEST(DefaultFace, NoseRootSitsInADipUnderTheGlabella) {
     EXPECT_LT(nasion_y - subnasale_y, 58.0) << "nasion " << nasion_y << ", subnasale " << subnasale_y;
 }
 
+// Below the lower lid the skin runs forward into the cheek (face.json
+// lid_rise). On the eyeball's shell alone the lid followed the globe back
+// and down: 0.6 mm deep a trench ran under the lid, a wall rose from it to
+// the cheek, and each eye sat in a ring like a swim goggle's (blind review
+// round 15). Measured on the shape itself: the test face's rows are coarser
+// than the trench.
+TEST(DefaultFace, LowerLidRunsIntoTheCheekWithoutATrench) {
+    const detail::FaceParams params = detail::read_face_params(testing::data_dir() + "/face");
+    detail::FaceShape shape(params);
+    shape.set_eye_corners(params.inner_corner[0], params.outer_corner[0]);
+    // The skin's z in front of (x, y): out from inside the head to its
+    // volume's surface, then displaced.
+    auto skin_z = [&](double x, double y) {
+        const glm::dvec3 origin{x, y, 0.0}, forward{0.0, 0.0, 1.0};
+        return shape.displace(origin + forward * shape.cast(origin, forward)).z;
+    };
+    for (const double at : {0.35, 0.5, 0.65}) {  // along the lid, inner to outer
+        const double x = glm::mix(params.inner_corner[0], params.outer_corner[0], at);
+        const double margin = shape.eye.lower(x);
+        double highest = skin_z(x, margin - 0.5), deepest_dip = 0.0, dip_at = 0.0;
+        for (double y = margin - 0.5; y > margin - params.lid_blend_outer - 3.0; y -= 0.25) {
+            const double z = skin_z(x, y);
+            highest = std::max(highest, z);
+            if (highest - z > deepest_dip) deepest_dip = highest - z, dip_at = margin - y;
+        }
+        EXPECT_LT(deepest_dip, 0.25) << "at x " << x << ": a trench " << deepest_dip << " mm deep, " << dip_at
+                                     << " mm below the lower lid's margin";
+    }
+}
+
 TEST(DefaultFace, EyeballsSitUnderOpenLidsAndPartsAreContiguous) {
     const Face& f = test_face();
     ASSERT_EQ(f.eyeballs.size(), 2u);
@@ -615,7 +646,7 @@ TEST_F(BadFaceParams, MessagesNameTheFileAndKey) {
          "expression: " + file + ": eyes.radiuss: expected a known key (centre, radius, iris_radius, pupil_radius, "
                                 "cornea, inner_corner, outer_corner, upper_lid_height, lower_lid_height, upper_lid_peak, "
                                 "lower_lid_peak, lid_clearance, lid_thickness, lid_blend_inner, lid_blend_outer, "
-                                "lid_warp_reach, sclera_corner_tint, sclera_vessels, lid_shadow, lash_line, lid_crease, upper_lashes, lower_lashes), found \"radiuss\""},
+                                "lid_rise, lid_warp_reach, sclera_corner_tint, sclera_vessels, lid_shadow, lash_line, lid_crease, upper_lashes, lower_lashes), found \"radiuss\""},
         {replaced("\"amount\": [0.7, 0.95]", "\"amount\": [0.7, 1.5]"),
          "expression: " + file + ": eyes.lash_line.amount: expected two amounts in [0, 1], found [0.7,1.5]"},
         {replaced("\"iris_radius\": 5.9,", ""), "expression: " + file + ": eyes.iris_radius: expected a value, found no such key"},
