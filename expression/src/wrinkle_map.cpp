@@ -531,7 +531,10 @@ struct Midline {
 std::vector<Stroke> key_strokes(const WrinkleLibrarySpec& spec, const WrinkleSources& sources,
                                 const FeatureLayout& layout) {
     std::vector<Stroke> strokes;
-    for (const WrinkleSource& source : sources) {
+    // The neutral key is the resting face: its lines stay under every AU
+    // key, which adds its own on top (render::key_weights keeps neutral at 1).
+    const WrinkleSources resting{{kRestingLines, AuSide::Both, 1.0f}};
+    for (const WrinkleSource& source : sources.empty() ? resting : sources) {
         const AuWrinkles* au = spec.find(source.au);
         if (!au || source.intensity <= 0.0f) continue;
         // A side's wrinkles stay on its half (a glabella furrow's shoulder
@@ -557,10 +560,33 @@ void for_each_row_band(int rows, RowFn&& fn) {
 }  // namespace
 
 const AuWrinkles* WrinkleLibrarySpec::find(int au) const {
+    if (au == kRestingLines) return resting.left.empty() && resting.right.empty() && resting.across.empty() ? nullptr : &resting;
     for (const AuWrinkles& a : action_units)
         if (a.au == au) return &a;
     return nullptr;
 }
+
+namespace {
+
+// An AU's entry, or the resting lines': its "left", "right" and "across" lists.
+AuWrinkles read_sided_wrinkles(const JsonReader& value, int au_number) {
+    JsonReader entry = value.as_object();
+    entry.comment("why");
+    AuWrinkles w;
+    w.au = au_number;
+    const auto read_list = [&](const char* key, std::vector<WrinkleSpec>& out) {
+        if (!entry.has(key)) return;
+        for (const JsonReader& item : entry.at(key).elements()) out.push_back(read_wrinkle(item));
+    };
+    read_list("left", w.left);
+    read_list("right", w.right);
+    read_list("across", w.across);
+    entry.finish();
+    if (w.left.empty() && w.right.empty() && w.across.empty()) entry.fail("wrinkles in \"left\", \"right\" or \"across\"");
+    return w;
+}
+
+}  // namespace
 
 WrinkleLibrarySpec load_wrinkle_spec(const std::string& path) {
     return detail::read_json_file(path, [](JsonReader& root) {
@@ -577,22 +603,9 @@ WrinkleLibrarySpec load_wrinkle_spec(const std::string& path) {
             if (spec.find(term->number))
                 fail<InputError>("expression: {}: expected each AU once, found AU{} again", value.loc().str(),
                                  term->number);
-            JsonReader au = value.as_object();
-            au.comment("why");
-            AuWrinkles w;
-            w.au = term->number;
-            const auto read_list = [&](const char* key, std::vector<WrinkleSpec>& out) {
-                if (!au.has(key)) return;
-                for (const JsonReader& item : au.at(key).elements()) out.push_back(read_wrinkle(item));
-            };
-            read_list("left", w.left);
-            read_list("right", w.right);
-            read_list("across", w.across);
-            au.finish();
-            if (w.left.empty() && w.right.empty() && w.across.empty())
-                au.fail("wrinkles in \"left\", \"right\" or \"across\"");
-            spec.action_units.push_back(std::move(w));
+            spec.action_units.push_back(read_sided_wrinkles(value, term->number));
         }
+        if (root.has("resting")) spec.resting = read_sided_wrinkles(root.at("resting"), kRestingLines);
         if (root.has("fold_shape")) {
             JsonReader f = root.object("fold_shape");
             f.comment("why");

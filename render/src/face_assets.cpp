@@ -118,7 +118,9 @@ WrinkleKey make_emotion_key(const FaceAssets& a, std::optional<expression::Emoti
     check_wrinkle_map_size(size, "render: wrinkle map size");
     if (!emotion) return make_wrinkle_key(a.face, *a.rig, a.wrinkles, "neutral", {}, {}, size, a.layout);
     const expression::AuIntensities& aus = a.emotions.prototypes[std::size_t(expression::emotion_index(*emotion))];
-    expression::WrinkleSources sources;
+    // The emotion keys blend with neutral (key_weights), so each carries
+    // the resting lines too, or they would fade as the emotion rises.
+    expression::WrinkleSources sources{{expression::kRestingLines, expression::AuSide::Both, 1.0f}};
     for (const expression::AuWrinkles& w : a.wrinkles.action_units)
         if (aus.mean(w.au) > 0.0)  // prototypes are symmetric
             sources.push_back({w.au, expression::AuSide::Both, float(aus.mean(w.au))});

@@ -53,6 +53,9 @@ Key make_key(const std::string& name) {
     if (name == "neutral") return {};
     if (const auto e = find_emotion(name)) {
         Key k;
+        // The resting lines too: an emotion key blends with neutral
+        // (render/src/face_assets.cpp make_emotion_key).
+        k.sources.push_back({kRestingLines, AuSide::Both, 1.0f});
         const AuIntensities& aus = profiles().prototypes[emotion_index(*e)];
         for (const AuWrinkles& w : spec().action_units)
             if (aus.mean(w.au) > 0.0) k.sources.push_back({w.au, AuSide::Both, float(aus.mean(w.au))});
@@ -264,14 +267,28 @@ constexpr float kSteepestGlabellaTilt = 0.6f;
 
 class WrinklePlacement : public ::testing::TestWithParam<Placement> {};
 
+// The resting lines' tilt in a region at a key's layout (wrinkles.json
+// "resting"): an emotion key carries them, so "smooth" there means no more
+// than the resting face shows.
+float resting_tilt(const std::string& key, Region region) {
+    const NormalMap map = generate_wrinkle_map(spec(), {{kRestingLines, AuSide::Both, 1.0f}}, key_layout(key), 256);
+    float sum = 0.0f;
+    const auto rects = region_rects(region, key_layout(key));
+    for (const Rect& r : rects) sum += mean_tilt(map, r);
+    return sum / static_cast<float>(rects.size());
+}
+
 TEST_P(WrinklePlacement, WhereItsMusclesFoldTheSkin) {
     const Placement p = GetParam();
     const float tilt = region_tilt(p.key, p.region);
     std::printf("%s %s: %.4f\n", p.key, region_name(p.region), tilt);
-    if (p.strong)
+    if (p.strong) {
         EXPECT_GT(tilt, kStrong) << p.key << " should wrinkle the " << region_name(p.region);
-    else
-        EXPECT_LT(tilt, kWeak) << p.key << " should leave the " << region_name(p.region) << " smooth";
+    } else {
+        const bool resting = make_key(p.key).sources.size() > 0 && make_key(p.key).sources[0].au == kRestingLines;
+        const float smooth = resting ? std::max(kWeak, resting_tilt(p.key, p.region) + 0.002f) : kWeak;
+        EXPECT_LT(tilt, smooth) << p.key << " should leave the " << region_name(p.region) << " smooth";
+    }
 }
 
 std::string placement_name(const ::testing::TestParamInfo<Placement>& info) {
@@ -344,6 +361,34 @@ TEST(WrinklePlacement, NeutralHasOnlyFineDetail) {
         EXPECT_LT(neutral, kStrong) << region_name(region);
         EXPECT_LT(neutral, strongest / 3.0f) << region_name(region);
     }
+}
+
+// The resting face's forehead lines (wrinkles.json "resting") are in the
+// neutral key and in each emotion key, never in an AU key, which adds its
+// own folds on top of neutral's: joy's forehead shows them as neutral's
+// does, AU6L's map is flat there, and without a "resting" entry the
+// neutral forehead has only the skin's fine detail.
+TEST(RestingLines, InTheNeutralAndEmotionKeysNotInAuKeys) {
+    const auto deepest_in_forehead = [](const std::vector<float>& h, const FeatureLayout& l) {
+        const Rect r = region_rects(Region::Forehead, l)[0];
+        float deepest = 0.0f;
+        for (int y = std::max(0, int(r.min.y * 256)); y < std::min(256, int(r.max.y * 256)); ++y)
+            for (int x = std::max(0, int(r.min.x * 256)); x < std::min(256, int(r.max.x * 256)); ++x)
+                deepest = std::min(deepest, h[std::size_t(y) * 256 + std::size_t(x)]);
+        return -deepest / l.face_unit();  // face units
+    };
+    const float neutral = deepest_in_forehead(key_height("neutral"), key_layout("neutral"));
+    const float joy = deepest_in_forehead(key_height("joy"), key_layout("joy"));
+    const float au6 = deepest_in_forehead(key_height("AU6L"), key_layout("AU6L"));
+    WrinkleLibrarySpec without = spec();
+    without.resting = {};
+    const float bare = deepest_in_forehead(render_height_field(without, {}, key_layout("neutral"), 256), key_layout("neutral"));
+    std::printf("forehead's deepest valley (face units): neutral %.4f, joy %.4f, AU6L %.4f, neutral without resting %.4f\n",
+                neutral, joy, au6, bare);
+    EXPECT_GT(neutral, 0.003f);
+    EXPECT_GT(joy, 0.7f * neutral);
+    EXPECT_EQ(au6, 0.0f);
+    EXPECT_LT(bare, 0.2f * neutral);
 }
 
 TEST(WrinklePlacement, SurpriseAndAngerAreOpposites) {
@@ -989,8 +1034,12 @@ INSTANTIATE_TEST_SUITE_P(
                 "action_units.AU6.left[0].dpeth: expected a known key (name, profile, points, depth, width, taper, taper_end, "
                 "crease, count, step, depth_falloff, side, shoulder, asymmetry, why), found \"dpeth\""},
         BadSpec{"typo_at_top", R"({"action_units": {}, "neutral_skin_detial": {}})",
-                "neutral_skin_detial: expected a known key (action_units, fold_shape, cavity, neutral_skin_detail, "
+                "neutral_skin_detial: expected a known key (action_units, resting, fold_shape, cavity, neutral_skin_detail, "
                 "about), found \"neutral_skin_detial\""},
+        BadSpec{"empty_resting", R"({"action_units": {}, "resting": {"why": "x"}})",
+                "resting: expected wrinkles in \"left\", \"right\" or \"across\", found {\"why\":\"x\"}"},
+        BadSpec{"resting_typo", R"({"action_units": {}, "resting": {"acros": []}})",
+                "resting.acros: expected a known key (left, right, across, why), found \"acros\""},
         BadSpec{"no_points", R"({"action_units": {"AU6": {"left": [{"name": "a"}]}}})",
                 "action_units.AU6.left[0].points: expected a value, found no such key"},
         BadSpec{"empty_points", R"({"action_units": {"AU6": {"left": [{"name": "a", "points": []}]}}})",

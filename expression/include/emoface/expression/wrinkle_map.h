@@ -109,12 +109,18 @@ struct AuWrinkles {
     std::vector<WrinkleSpec> across;       // over the midline: split softly between the sides
 };
 
+// The AU number that stands for the face's resting lines (wrinkles.json
+// "resting"): the neutral key shows them, and an emotion key, which the
+// thesis's blend mixes with neutral, names them among its sources.
+constexpr int kRestingLines = 0;
+
 struct WrinkleLibrarySpec {
     std::vector<AuWrinkles> action_units;  // in file order, each AU once
+    AuWrinkles resting;                    // au kRestingLines; may be empty
     SkinDetail neutral_detail;
     FoldShape fold;
     CavitySpec cavity;
-    const AuWrinkles* find(int au) const;  // nullptr: the AU makes no wrinkles
+    const AuWrinkles* find(int au) const;  // nullptr: the AU makes no wrinkles (kRestingLines: the resting lines)
 };
 
 // One AU's wrinkles in a key map: the side's list plus its half of the
@@ -125,8 +131,9 @@ struct WrinkleSource {
     AuSide side = AuSide::Both;
     float intensity = 1.0f;
 };
-// What a key map shows: the sources' wrinkles; none: the neutral skin's
-// fine detail (wrinkles.json "neutral_skin_detail").
+// What a key map shows: the sources' wrinkles; none: the neutral key, the
+// resting lines and the skin's fine detail (wrinkles.json "resting" and
+// "neutral_skin_detail").
 using WrinkleSources = std::vector<WrinkleSource>;
 
 // Loads data/expression/wrinkles.json; errors name the file, AU, side and
