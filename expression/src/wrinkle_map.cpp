@@ -533,7 +533,7 @@ std::vector<Stroke> key_strokes(const WrinkleLibrarySpec& spec, const WrinkleSou
     std::vector<Stroke> strokes;
     // The neutral key is the resting face: its lines stay under every AU
     // key, which adds its own on top (render::key_weights keeps neutral at 1).
-    const WrinkleSources resting{{kRestingLines, AuSide::Both, 1.0f}};
+    static const WrinkleSources resting{kRestingLinesSource};
     for (const WrinkleSource& source : sources.empty() ? resting : sources) {
         const AuWrinkles* au = spec.find(source.au);
         if (!au || source.intensity <= 0.0f) continue;
@@ -560,7 +560,7 @@ void for_each_row_band(int rows, RowFn&& fn) {
 }  // namespace
 
 const AuWrinkles* WrinkleLibrarySpec::find(int au) const {
-    if (au == kRestingLines) return resting.left.empty() && resting.right.empty() && resting.across.empty() ? nullptr : &resting;
+    if (au == kRestingLines) return resting.empty() ? nullptr : &resting;
     for (const AuWrinkles& a : action_units)
         if (a.au == au) return &a;
     return nullptr;
@@ -582,7 +582,7 @@ AuWrinkles read_sided_wrinkles(const JsonReader& value, int au_number) {
     read_list("right", w.right);
     read_list("across", w.across);
     entry.finish();
-    if (w.left.empty() && w.right.empty() && w.across.empty()) entry.fail("wrinkles in \"left\", \"right\" or \"across\"");
+    if (w.empty()) entry.fail("wrinkles in \"left\", \"right\" or \"across\"");
     return w;
 }
 

@@ -120,7 +120,7 @@ WrinkleKey make_emotion_key(const FaceAssets& a, std::optional<expression::Emoti
     const expression::AuIntensities& aus = a.emotions.prototypes[std::size_t(expression::emotion_index(*emotion))];
     // The emotion keys blend with neutral (key_weights), so each carries
     // the resting lines too, or they would fade as the emotion rises.
-    expression::WrinkleSources sources{{expression::kRestingLines, expression::AuSide::Both, 1.0f}};
+    expression::WrinkleSources sources{expression::kRestingLinesSource};
     for (const expression::AuWrinkles& w : a.wrinkles.action_units)
         if (aus.mean(w.au) > 0.0)  // prototypes are symmetric
             sources.push_back({w.au, expression::AuSide::Both, float(aus.mean(w.au))});

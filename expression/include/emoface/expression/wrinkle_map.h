@@ -107,6 +107,7 @@ struct AuWrinkles {
     int au = 0;
     std::vector<WrinkleSpec> left, right;  // on that side of the face
     std::vector<WrinkleSpec> across;       // over the midline: split softly between the sides
+    bool empty() const { return left.empty() && right.empty() && across.empty(); }
 };
 
 // The AU number that stands for the face's resting lines (wrinkles.json
@@ -131,6 +132,8 @@ struct WrinkleSource {
     AuSide side = AuSide::Both;
     float intensity = 1.0f;
 };
+// The resting lines, whole, as a key's source.
+constexpr WrinkleSource kRestingLinesSource{kRestingLines, AuSide::Both, 1.0f};
 // What a key map shows: the sources' wrinkles; none: the neutral key, the
 // resting lines and the skin's fine detail (wrinkles.json "resting" and
 // "neutral_skin_detail").
