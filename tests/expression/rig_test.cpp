@@ -4,10 +4,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "emoface/common/error.h"
 #include "emoface/fap/fap_table.h"
+#include "emoface/expression/profiles.h"
 #include "emoface/fap/feature_points.h"
 #include "test_face.h"
 
@@ -218,6 +222,76 @@ TEST(Rig, OpenJawOpensAnOvalNarrowingIntoTheCorners) {
     EXPECT_GT(half_right, 2.0);
     EXPECT_LT(half_left, 0.85 * mid);
     EXPECT_LT(half_right, 0.85 * mid);
+}
+
+// What a ray along -z from (x, y, in front of the face) meets first.
+struct Hit {
+    VertexPart part;  // its triangle's first vertex's
+    bool back;        // the triangle faces away from the ray's origin: the surface's inside
+};
+std::optional<Hit> first_hit(const Face& face, const DeformedFace& d, double x, double y) {
+    std::optional<Hit> hit;
+    double nearest = -1e9;
+    for (const auto fh : face.mesh.faces()) {
+        std::array<int, 3> v{};
+        int k = 0;
+        for (const auto vh : face.mesh.fv_range(fh)) v[k++] = vh.idx();
+        const auto &a = d.positions[v[0]], &b = d.positions[v[1]], &c = d.positions[v[2]];
+        // Barycentric coordinates of (x, y) in the triangle's xy projection.
+        const double det = (b[1] - c[1]) * (a[0] - c[0]) + (c[0] - b[0]) * (a[1] - c[1]);
+        if (std::abs(det) < 1e-12) continue;
+        const double l0 = ((b[1] - c[1]) * (x - c[0]) + (c[0] - b[0]) * (y - c[1])) / det;
+        const double l1 = ((c[1] - a[1]) * (x - c[0]) + (a[0] - c[0]) * (y - c[1])) / det;
+        const double l2 = 1.0 - l0 - l1;
+        if (l0 < 0 || l1 < 0 || l2 < 0) continue;
+        const double z = l0 * a[2] + l1 * b[2] + l2 * c[2];
+        if (z > nearest) nearest = z, hit = Hit{face.parts[v[0]], det < 0};
+    }
+    return hit;
+}
+
+// Looking into an open mouth one sees its inside up to the corners: the
+// cavity, teeth or tongue, never the skin's inside past the cavity's rim
+// (with the cavity 25 mm wide beside 26 mm lip corners, surprise and fear
+// showed a skin-lit triangle in the face's left corner, round 18).
+TEST(Rig, AnOpenMouthShowsItsInsideIntoTheCorners) {
+    const EmotionProfiles profiles =
+        load_emotion_profiles(std::string(EMOFACE_DATA_DIR) + "/expression/emotions.json");
+    const Face& face = test_face();
+    struct Case {
+        std::string what;
+        FapValues faps;
+    };
+    std::vector<Case> cases;
+    for (const Emotion e : kEmotions) cases.push_back({emotion_name(e), profiles.profiles[emotion_index(e)]});
+    FapValues jaw{};
+    jaw[3 - 1] = 700;
+    cases.push_back({"open jaw 700", jaw});
+    FapValues scream{};  // the widest open mouth the AUs make: lips stretched, jaw stretched open
+    for (const int au : {20, 27})
+        for (std::size_t i = 0; i < scream.size(); ++i) scream[i] += profiles.action_units.find(au)->faps[i];
+    cases.push_back({"AU20 + AU27", scream});
+    int looked = 0;
+    for (const Case& c : cases) {
+        const DeformedFace d = test_rig().deform(c.faps);
+        for (const auto& [corner, upper, lower] : {std::array<const char*, 3>{"2.4", "2.6", "2.8"},
+                                                   std::array<const char*, 3>{"2.5", "2.7", "2.9"}}) {
+            const Vec3d k = d.feature_points[fp(corner)], u = d.feature_points[fp(upper)],
+                        l = d.feature_points[fp(lower)];
+            if (u[1] - l[1] < 2.0) continue;  // closed there
+            for (const double t : {0.05, 0.1, 0.2, 0.35}) {
+                // On the line from the corner to the middle of the half-way gap.
+                const double x = k[0] + t * (0.5 * (u[0] + l[0]) - k[0]), y = k[1] + t * (0.5 * (u[1] + l[1]) - k[1]);
+                const auto hit = first_hit(face, d, x, y);
+                ASSERT_TRUE(hit.has_value()) << c.what << ": nothing behind the mouth at " << corner;
+                EXPECT_FALSE(hit->part == VertexPart::Skin && hit->back)
+                    << c.what << ": the skin's inside shows " << t << " of the way in from corner " << corner;
+                ++looked;
+            }
+        }
+    }
+    std::printf("looked into %d points of open mouths\n", looked);
+    EXPECT_GE(looked, 24);
 }
 
 TEST(Rig, ClosingEyelids1024PutsUpperOnLowerAlongTheWholeMargin) {
