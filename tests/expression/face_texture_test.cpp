@@ -117,18 +117,11 @@ Texel seen_at(double x, double y, const Face& f = painted_face()) {
         for (const auto vh : v)
             skin = skin && f.parts[vh.idx()] == VertexPart::Skin && f.mesh.texcoord2D(vh)[1] >= 0.25;
         if (!skin) continue;
-        const auto a = f.mesh.point(v[0]), b = f.mesh.point(v[1]), c = f.mesh.point(v[2]);
-        const double d = (b[1] - c[1]) * (a[0] - c[0]) + (c[0] - b[0]) * (a[1] - c[1]);
-        if (std::abs(d) < 1e-12) continue;
-        const double w0 = ((b[1] - c[1]) * (x - c[0]) + (c[0] - b[0]) * (y - c[1])) / d;
-        const double w1 = ((c[1] - a[1]) * (x - c[0]) + (a[0] - c[0]) * (y - c[1])) / d;
-        const double w2 = 1.0 - w0 - w1;
-        if (w0 < 0 || w1 < 0 || w2 < 0) continue;
-        const double z = w0 * a[2] + w1 * b[2] + w2 * c[2];
-        if (z <= best_z) continue;
-        best_z = z;
-        uv = f.mesh.texcoord2D(v[0]) * static_cast<float>(w0) + f.mesh.texcoord2D(v[1]) * static_cast<float>(w1) +
-             f.mesh.texcoord2D(v[2]) * static_cast<float>(w2);
+        const auto hit = testing::front_crossing(f.mesh.point(v[0]), f.mesh.point(v[1]), f.mesh.point(v[2]), x, y);
+        if (!hit || hit->z <= best_z) continue;
+        best_z = hit->z;
+        uv = OpenMesh::Vec2f(0.0f, 0.0f);
+        for (int k = 0; k < 3; ++k) uv += f.mesh.texcoord2D(v[k]) * static_cast<float>(hit->w[k]);
     }
     return texel_at(uv[0], uv[1], f);
 }

@@ -234,16 +234,8 @@ std::optional<Hit> first_hit(const Face& face, const DeformedFace& d, const Tria
     std::optional<Hit> hit;
     double nearest = -1e9;
     for (const auto& v : triangles) {
-        const auto &a = d.positions[v[0]], &b = d.positions[v[1]], &c = d.positions[v[2]];
-        // Barycentric coordinates of (x, y) in the triangle's xy projection.
-        const double det = (b[1] - c[1]) * (a[0] - c[0]) + (c[0] - b[0]) * (a[1] - c[1]);
-        if (std::abs(det) < 1e-12) continue;
-        const double l0 = ((b[1] - c[1]) * (x - c[0]) + (c[0] - b[0]) * (y - c[1])) / det;
-        const double l1 = ((c[1] - a[1]) * (x - c[0]) + (a[0] - c[0]) * (y - c[1])) / det;
-        const double l2 = 1.0 - l0 - l1;
-        if (l0 < 0 || l1 < 0 || l2 < 0) continue;
-        const double z = l0 * a[2] + l1 * b[2] + l2 * c[2];
-        if (z > nearest) nearest = z, hit = Hit{face.parts[v[0]], det < 0};
+        const auto crossing = testing::front_crossing(d.positions[v[0]], d.positions[v[1]], d.positions[v[2]], x, y);
+        if (crossing && crossing->z > nearest) nearest = crossing->z, hit = Hit{face.parts[v[0]], !crossing->facing};
     }
     return hit;
 }
