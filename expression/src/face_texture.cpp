@@ -687,11 +687,10 @@ Texel Painter::skin(glm::dvec3 q) const {
         // smear; the dots give it a grain at a 1024 px crop.
         if (beard > 0.05) {
             // Laid out round the head: the azimuth about an axis 20 mm
-            // behind the face's centre, in mm at the cheek (about 1 mm per
-            // mm from the chin to the jaw's side), each side its own dots.
-            // (|x| - z stood still where the skin beside a mouth corner
-            // comes forward as it goes out, and its dots ran together into
-            // a dark dotted line down the cheek.)
+            // behind the face's centre, about 1 mm per mm of skin from the
+            // chin round to the jaw's side, each side its own dots. (|x| - z
+            // would stand still wherever the skin came forward as fast as
+            // it went out, and its dots would run into lines there.)
             const double around = (q.x >= 0.0 ? 1.0 : -1.0) * (90.0 * std::atan2(ax, q.z + 20.0) + 200.0);
             const double dot = spots(around, q.y, 0.75, 0.8, 0.22, 171);
             c = blend(c, c * Rgb{0.62, 0.62, 0.66}, std::min(1.0, 1.1 * al.beard_amount * beard) * dot);
