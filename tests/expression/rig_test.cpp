@@ -243,28 +243,30 @@ std::optional<Hit> first_hit(const Face& face, const DeformedFace& d, const Tria
 // Mouths in the poses that open or stretch them most: the six emotions,
 // the jaw dropped, and the widest open mouth the AUs make (lips stretched,
 // jaw stretched open); with the triangles that lie round the mouth.
-class OpenMouths : public ::testing::Test {
-protected:
-    struct Case {
-        std::string what;
-        DeformedFace d;
-    };
-    static void SetUpTestSuite() {
+struct OpenMouthCase {
+    std::string what;
+    DeformedFace d;
+};
+struct OpenMouthPoses {
+    std::vector<OpenMouthCase> cases;
+    Triangles triangles;
+};
+const OpenMouthPoses& open_mouths() {
+    static const OpenMouthPoses poses = [] {
         const EmotionProfiles profiles =
             load_emotion_profiles(std::string(EMOFACE_DATA_DIR) + "/expression/emotions.json");
-        cases_ = new std::vector<Case>;
+        OpenMouthPoses m;
         for (const Emotion e : kEmotions)
-            cases_->push_back({emotion_name(e), test_rig().deform(profiles.profiles[emotion_index(e)])});
+            m.cases.push_back({emotion_name(e), test_rig().deform(profiles.profiles[emotion_index(e)])});
         FapValues jaw{};
         jaw[3 - 1] = 700;
-        cases_->push_back({"open jaw 700", test_rig().deform(jaw)});
+        m.cases.push_back({"open jaw 700", test_rig().deform(jaw)});
         FapValues scream{};
         for (const int au : {20, 27})
             for (std::size_t i = 0; i < scream.size(); ++i) scream[i] += profiles.action_units.find(au)->faps[i];
-        cases_->push_back({"AU20 + AU27", test_rig().deform(scream)});
+        m.cases.push_back({"AU20 + AU27", test_rig().deform(scream)});
         const Face& face = test_face();
         const Vec3d stomion = face.position(fp("2.2"));
-        triangles_ = new Triangles;
         for (const auto fh : face.mesh.faces()) {
             std::array<int, 3> v{};
             int k = 0;
@@ -274,27 +276,21 @@ protected:
                 const auto p = face.mesh.point(vh);
                 near |= std::abs(p[0] - stomion[0]) < 60 && std::abs(p[1] - stomion[1]) < 45;
             }
-            if (near) triangles_->push_back(v);
+            if (near) m.triangles.push_back(v);
         }
-    }
-    static void TearDownTestSuite() {
-        delete cases_;
-        delete triangles_;
-    }
-    static std::vector<Case>* cases_;
-    static Triangles* triangles_;
-};
-std::vector<OpenMouths::Case>* OpenMouths::cases_ = nullptr;
-Triangles* OpenMouths::triangles_ = nullptr;
+        return m;
+    }();
+    return poses;
+}
 
 // Looking into an open mouth one sees its inside up to the corners: the
 // cavity, teeth or tongue, never the skin's inside past the cavity's rim
 // (with the cavity 25 mm wide beside 26 mm lip corners, surprise and fear
 // showed a skin-lit triangle in the face's left corner, round 18).
-TEST_F(OpenMouths, ShowTheirInsideIntoTheCorners) {
+TEST(OpenMouths, ShowTheirInsideIntoTheCorners) {
     const Face& face = test_face();
     int looked = 0;
-    for (const Case& c : *cases_) {
+    for (const OpenMouthCase& c : open_mouths().cases) {
         const DeformedFace& d = c.d;
         for (const auto& [corner, upper, lower] : {std::array<const char*, 3>{"2.4", "2.6", "2.8"},
                                                    std::array<const char*, 3>{"2.5", "2.7", "2.9"}}) {
@@ -304,7 +300,7 @@ TEST_F(OpenMouths, ShowTheirInsideIntoTheCorners) {
             for (const double t : {0.05, 0.1, 0.2, 0.35}) {
                 // On the line from the corner to the middle of the half-way gap.
                 const double x = k[0] + t * (0.5 * (u[0] + l[0]) - k[0]), y = k[1] + t * (0.5 * (u[1] + l[1]) - k[1]);
-                const auto hit = first_hit(face, d, *triangles_, x, y);
+                const auto hit = first_hit(face, d, open_mouths().triangles, x, y);
                 ASSERT_TRUE(hit.has_value()) << c.what << ": nothing behind the mouth at " << corner;
                 EXPECT_FALSE(hit->part == VertexPart::Skin && hit->back)
                     << c.what << ": the skin's inside shows " << t << " of the way in from corner " << corner;
@@ -320,10 +316,10 @@ TEST_F(OpenMouths, ShowTheirInsideIntoTheCorners) {
 // does the cavity (or a tooth) stand in front of the skin (a cavity 34 mm
 // wide about z 70 came through the cheek beside anger's tightened corners
 // as a dark red line).
-TEST_F(OpenMouths, KeepTheirInsideBehindTheSkin) {
+TEST(OpenMouths, KeepTheirInsideBehindTheSkin) {
     const Face& face = test_face();
     int inside_seen = 0;
-    for (const Case& c : *cases_) {
+    for (const OpenMouthCase& c : open_mouths().cases) {
         const DeformedFace& d = c.d;
         // The lips' opening: the box round the inner contour.
         double x0 = 1e9, x1 = -1e9, y0 = 1e9, y1 = -1e9;
@@ -334,7 +330,7 @@ TEST_F(OpenMouths, KeepTheirInsideBehindTheSkin) {
         const Vec3d stomion = d.feature_points[fp("2.2")];
         for (double y = stomion[1] - 30; y <= stomion[1] + 20; y += 1.0)
             for (double x = stomion[0] - 50; x <= stomion[0] + 50; x += 1.0) {
-                const auto hit = first_hit(face, d, *triangles_, x, y);
+                const auto hit = first_hit(face, d, open_mouths().triangles, x, y);
                 if (!hit || hit->part == VertexPart::Skin) continue;
                 ++inside_seen;
                 EXPECT_TRUE(x > x0 - 0.5 && x < x1 + 0.5 && y > y0 - 0.5 && y < y1 + 0.5)
